@@ -1,0 +1,86 @@
+//! The `emilion bench` benchmark: the peer hanging-cloth scene at several resolutions, one JSON
+//! line per case with the median time per substep over several runs after a warm-up.
+
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::cloth::ClothError;
+use crate::scenes;
+
+/// One benchmark case's result.
+#[derive(Debug, Clone, Serialize)]
+pub struct BenchResult {
+    /// Scene name.
+    pub scene: String,
+    /// Particles per side.
+    pub n: usize,
+    /// Particle count.
+    pub vertices: usize,
+    /// Frames simulated per run.
+    pub frames: u32,
+    /// Substeps per frame.
+    pub substeps: u32,
+    /// Median wall time per substep over the runs (ms).
+    pub substep_ms: f64,
+    /// Every run's time per substep (ms).
+    pub runs_ms: Vec<f64>,
+    /// Mean CG iterations per substep (of the median run).
+    pub cg_iters: f64,
+    /// Largest CG iteration count of a substep.
+    pub cg_iters_max: u32,
+    /// Mean assembly time per substep (ms).
+    pub assemble_ms: f64,
+    /// Mean solve time per substep (ms).
+    pub solve_ms: f64,
+    /// CG relative tolerance used.
+    pub cg_tolerance: f64,
+    /// Substeps whose solve did not reach the tolerance.
+    pub unconverged: u64,
+    /// Worker threads.
+    pub threads: usize,
+}
+
+/// Runs the hang scene at `n` × `n` for `frames` frames of 5 substeps, `runs` times after one
+/// warm-up run, and returns the median.
+pub fn bench_hang(n: usize, frames: u32, runs: usize) -> Result<BenchResult, ClothError> {
+    let substeps = 5;
+    let mut results = Vec::new();
+    for r in 0..=runs {
+        let mut sim = scenes::hang(n)?;
+        let steps = (frames * substeps) as u64;
+        let t0 = Instant::now();
+        sim.run_steps(steps, |_, _| Ok(()))?;
+        let ms = t0.elapsed().as_secs_f64() * 1e3 / steps as f64;
+        if r > 0 {
+            let s = &sim.stats;
+            let k = s.len() as f64;
+            let iters = s.iter().map(|x| x.cg_iterations as f64).sum::<f64>() / k;
+            let imax = s.iter().map(|x| x.cg_iterations).max().unwrap_or(0);
+            let am = s.iter().map(|x| x.assemble_ms).sum::<f64>() / k;
+            let sm = s.iter().map(|x| x.solve_ms).sum::<f64>() / k;
+            results.push((ms, iters, imax, am, sm, sim.unconverged_steps, sim.params.cg_tolerance));
+        }
+    }
+    let mut runs_ms: Vec<f64> = results.iter().map(|r| r.0).collect();
+    let mut sorted = results.clone();
+    sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let med = sorted[sorted.len() / 2];
+    runs_ms.iter_mut().for_each(|x| *x = (*x * 1000.0).round() / 1000.0);
+    Ok(BenchResult {
+        scene: "hang".into(),
+        n,
+        vertices: n * n,
+        frames,
+        substeps,
+        substep_ms: med.0,
+        runs_ms,
+        cg_iters: med.1,
+        cg_iters_max: med.2,
+        assemble_ms: med.3,
+        solve_ms: med.4,
+        cg_tolerance: med.6,
+        unconverged: med.5,
+        threads: rayon::current_num_threads(),
+    })
+}

@@ -1,0 +1,306 @@
+//! Assembly of forces and of the implicit system `A Δv = b` with
+//! `A = M − h ∂f/∂v − h² ∂f/∂x` and `b = h (f + h ∂f/∂x v)` (Baraff & Witkin 1998).
+//!
+//! Two deterministic parallel passes, no allocation: (1) every element writes its per-node
+//! right-hand-side contributions and its stiffness blocks into its own slots of flat buffers;
+//! (2) every matrix row gathers them, in a fixed order, through contribution records built once
+//! per topology. The block-Jacobi preconditioner (inverse diagonal blocks) is formed in pass 2.
+
+use rayon::prelude::*;
+
+use super::bcsr::Bcsr3;
+use super::model::ClothModel;
+use super::parallel::{chunks, ordered_sum, SyncPtr, CHUNK};
+use crate::geometry::{Mat3, Vec3};
+
+/// One matrix contribution: `values[slot] += scale · blocks[src]`.
+#[derive(Debug, Clone, Copy)]
+struct Rec {
+    slot: u32,
+    src: u32,
+    scale: f64,
+}
+
+/// Preallocated buffers and the contribution records of a model's topology.
+#[derive(Debug, Clone)]
+pub struct Assembly {
+    /// The system matrix (pattern fixed).
+    pub a: Bcsr3,
+    /// Right-hand side b (or the force, in force-only mode).
+    pub b: Vec<Vec3>,
+    /// Inverse diagonal blocks (block-Jacobi preconditioner).
+    pub pinv: Vec<Mat3>,
+    blocks: Vec<Mat3>,
+    g: Vec<Vec3>,
+    recs: Vec<Rec>,
+    rec_ptr: Vec<usize>,
+    grecs: Vec<u32>,
+    grec_ptr: Vec<usize>,
+    bend_block0: usize,
+    hinge_block0: usize,
+    bend_g0: usize,
+    hinge_g0: usize,
+    energy_partials: Vec<f64>,
+}
+
+/// What to assemble.
+#[derive(Debug, Clone, Copy)]
+pub struct AssemblyInputs {
+    /// Step length h (s).
+    pub dt: f64,
+    /// Gravity (m/s²).
+    pub gravity: Vec3,
+    /// Build the matrix (implicit) or only forces (explicit).
+    pub matrix: bool,
+}
+
+impl Assembly {
+    /// Builds the pattern and the records of `model`.
+    pub fn new(model: &ClothModel) -> Self {
+        let n = model.particle_count();
+        let a = Bcsr3::with_pattern(n, &model.coupled_pairs());
+        let ns = model.springs.len();
+        let nb = model.bend_lines.len();
+        let nh = model.hinges.len();
+        let bend_block0 = ns;
+        let hinge_block0 = ns + nb;
+        let bend_g0 = 2 * ns;
+        let hinge_g0 = 2 * ns + 3 * nb;
+        let mut rows: Vec<Vec<Rec>> = vec![Vec::new(); n];
+        let mut grows: Vec<Vec<u32>> = vec![Vec::new(); n];
+        let slot = |i: usize, j: usize| a.slot(i, j).expect("pair in pattern") as u32;
+        for (s, sp) in model.springs.iter().enumerate() {
+            for (me, other, gi) in [(sp.a, sp.b, 2 * s), (sp.b, sp.a, 2 * s + 1)] {
+                rows[me].push(Rec { slot: slot(me, me), src: s as u32, scale: 1.0 });
+                rows[me].push(Rec { slot: slot(me, other), src: s as u32, scale: -1.0 });
+                grows[me].push(gi as u32);
+            }
+        }
+        for (e, bl) in model.bend_lines.iter().enumerate() {
+            for m in 0..3 {
+                let me = bl.nodes[m];
+                for k in 0..3 {
+                    rows[me].push(Rec {
+                        slot: slot(me, bl.nodes[k]),
+                        src: (bend_block0 + e) as u32,
+                        scale: bl.coef[m] * bl.coef[k],
+                    });
+                }
+                grows[me].push((bend_g0 + 3 * e + m) as u32);
+            }
+        }
+        for (h, hg) in model.hinges.iter().enumerate() {
+            for m in 0..4 {
+                let me = hg.nodes[m];
+                for k in 0..4 {
+                    rows[me].push(Rec {
+                        slot: slot(me, hg.nodes[k]),
+                        src: (hinge_block0 + 16 * h + 4 * m + k) as u32,
+                        scale: 1.0,
+                    });
+                }
+                grows[me].push((hinge_g0 + 4 * h + m) as u32);
+            }
+        }
+        let (recs, rec_ptr) = flatten(rows);
+        let (grecs, grec_ptr) = flatten(grows);
+        let n_elems = ns + nb + nh;
+        Assembly {
+            a,
+            b: vec![Vec3::zeros(); n],
+            pinv: vec![Mat3::identity(); n],
+            blocks: vec![Mat3::zeros(); ns + nb + 16 * nh],
+            g: vec![Vec3::zeros(); 2 * ns + 3 * nb + 4 * nh],
+            recs,
+            rec_ptr,
+            grecs,
+            grec_ptr,
+            bend_block0,
+            hinge_block0,
+            bend_g0,
+            hinge_g0,
+            energy_partials: vec![0.0; chunks(n_elems.max(1), CHUNK) + 3],
+        }
+    }
+
+    /// Evaluates all elements at (x, v) and assembles. In matrix mode, fills `a`, `b`, `pinv`
+    /// for the implicit step of length `dt`; in force-only mode, `b` receives the total force.
+    /// Returns the elastic energy at x.
+    pub fn assemble(&mut self, model: &ClothModel, x: &[Vec3], v: &[Vec3], inp: AssemblyInputs) -> f64 {
+        let energy = self.element_pass(model, x, v, inp);
+        self.gather_pass(model, v, inp);
+        energy
+    }
+
+    fn element_pass(&mut self, model: &ClothModel, x: &[Vec3], v: &[Vec3], inp: AssemblyInputs) -> f64 {
+        let law = &*model.law;
+        let fab = &model.fabric;
+        // factors: g = hf·(f + f_damp) − hk·(K v); blocks = bk·K (+ bc·K_axial)
+        let (hf, hk) = if inp.matrix { (inp.dt, inp.dt * inp.dt) } else { (1.0, 0.0) };
+        let (beta_s, beta_b) = (fab.stretch_damping, fab.bend_damping);
+        let ns = model.springs.len();
+        let nb = model.bend_lines.len();
+        let nsc = chunks(ns, CHUNK);
+        let nbc = chunks(nb, CHUNK);
+        let (blocks_s, rest) = self.blocks.split_at_mut(self.bend_block0);
+        let (blocks_b, blocks_h) = rest.split_at_mut(self.hinge_block0 - self.bend_block0);
+        let (g_s, rest) = self.g.split_at_mut(self.bend_g0);
+        let (g_b, g_h) = rest.split_at_mut(self.hinge_g0 - self.bend_g0);
+        let (ep_s, rest) = self.energy_partials.split_at_mut(nsc);
+        let (ep_b, ep_h) = rest.split_at_mut(nbc);
+        let matrix = inp.matrix;
+        // springs
+        model
+            .springs
+            .par_chunks(CHUNK)
+            .zip(blocks_s.par_chunks_mut(CHUNK))
+            .zip(g_s.par_chunks_mut(2 * CHUNK))
+            .zip(ep_s.par_iter_mut())
+            .for_each(|(((sp, bl), g), ep)| {
+                let mut e = 0.0;
+                for k in 0..sp.len() {
+                    let s = &sp[k];
+                    let ev = s.eval(law, &x[s.a], &x[s.b]);
+                    e += ev.energy;
+                    let rel = v[s.b] - v[s.a];
+                    let damp = beta_s * ev.axial * ev.dir.dot(&rel);
+                    let mut ga = ev.dir * ((ev.tension + damp) * hf);
+                    if matrix {
+                        let kmat = ev.stiffness();
+                        ga += kmat * rel * hk;
+                        let c = ev.dir * ev.dir.transpose() * (beta_s * ev.axial);
+                        bl[k] = kmat * hk + c * inp.dt;
+                    }
+                    g[2 * k] = ga;
+                    g[2 * k + 1] = -ga;
+                }
+                *ep = e;
+            });
+        // bending lines
+        model
+            .bend_lines
+            .par_chunks(CHUNK)
+            .zip(blocks_b.par_chunks_mut(CHUNK))
+            .zip(g_b.par_chunks_mut(3 * CHUNK))
+            .zip(ep_b.par_iter_mut())
+            .for_each(|(((els, bl), g), ep)| {
+                let mut e = 0.0;
+                for k in 0..els.len() {
+                    let el = &els[k];
+                    let (gen, s, en) = el.eval(law, x);
+                    e += en;
+                    let [a, b, c] = el.nodes;
+                    let w = v[a] * el.coef[0] + v[b] * el.coef[1] + v[c] * el.coef[2];
+                    let sw = s * w;
+                    // f_m = −c_m (gen + β S w);  K v contribution c_m S w
+                    for m in 0..3 {
+                        let cm = el.coef[m];
+                        g[3 * k + m] = -(gen + sw * beta_b) * (cm * hf) - sw * (cm * hk);
+                    }
+                    if matrix {
+                        bl[k] = s * (hk + inp.dt * beta_b);
+                    }
+                }
+                *ep = e;
+            });
+        // hinges
+        let hinge_e: f64 = if model.hinges.is_empty() {
+            0.0
+        } else {
+            model
+                .hinges
+                .par_chunks(CHUNK)
+                .zip(blocks_h.par_chunks_mut(16 * CHUNK))
+                .zip(g_h.par_chunks_mut(4 * CHUNK))
+                .zip(ep_h.par_iter_mut())
+                .for_each(|(((els, bl), g), ep)| {
+                    let mut e = 0.0;
+                    for k in 0..els.len() {
+                        let el = &els[k];
+                        let Some((theta, grad)) = el.angle_and_gradient(x) else {
+                            for m in 0..4 {
+                                g[4 * k + m] = Vec3::zeros();
+                                for q in 0..4 {
+                                    bl[16 * k + 4 * m + q] = Mat3::zeros();
+                                }
+                            }
+                            continue;
+                        };
+                        let kappa = theta.abs() * el.edge / el.area;
+                        let (mo, dm, w) = el.law(law, kappa);
+                        e += el.area * w;
+                        let dedtheta = el.edge * mo * theta.signum();
+                        let stiff = dm * el.edge * el.edge / el.area;
+                        let gv: f64 = (0..4).map(|m| grad[m].dot(&v[el.nodes[m]])).sum();
+                        for m in 0..4 {
+                            g[4 * k + m] = -grad[m] * (dedtheta * hf + stiff * gv * (beta_b * hf + hk));
+                            if matrix {
+                                for q in 0..4 {
+                                    bl[16 * k + 4 * m + q] = grad[m] * grad[q].transpose() * (stiff * (hk + inp.dt * beta_b));
+                                }
+                            }
+                        }
+                    }
+                    *ep = e;
+                });
+            ordered_sum(&ep_h[..chunks(model.hinges.len(), CHUNK)])
+        };
+        ordered_sum(&ep_s[..nsc]) + ordered_sum(&ep_b[..nbc]) + hinge_e
+    }
+
+    fn gather_pass(&mut self, model: &ClothModel, v: &[Vec3], inp: AssemblyInputs) {
+        let n = model.particle_count();
+        let drag = model.fabric.air_drag;
+        let h = inp.dt;
+        let matrix = inp.matrix;
+        let values = SyncPtr(self.a.values.as_mut_ptr());
+        let (row_ptr, diag) = (&self.a.row_ptr, &self.a.diag);
+        let (recs, rec_ptr, grecs, grec_ptr) = (&self.recs, &self.rec_ptr, &self.grecs, &self.grec_ptr);
+        let (blocks, g) = (&self.blocks, &self.g);
+        self.b
+            .par_chunks_mut(CHUNK)
+            .zip(self.pinv.par_chunks_mut(CHUNK))
+            .enumerate()
+            .for_each(|(c, (bs, ps))| {
+                for k in 0..bs.len() {
+                    let i = c * CHUNK + k;
+                    let m = model.mass[i];
+                    let da = drag * model.area[i];
+                    let mut rhs = inp.gravity * m - v[i] * da;
+                    if matrix {
+                        rhs *= h;
+                    }
+                    for &src in &grecs[grec_ptr[i]..grec_ptr[i + 1]] {
+                        rhs += g[src as usize];
+                    }
+                    bs[k] = rhs;
+                    if matrix {
+                        // SAFETY: row i's slots belong to this iteration only.
+                        unsafe {
+                            for s in row_ptr[i]..row_ptr[i + 1] {
+                                *values.at(s) = Mat3::zeros();
+                            }
+                            *values.at(diag[i]) = Mat3::identity() * (m + h * da);
+                            for r in &recs[rec_ptr[i]..rec_ptr[i + 1]] {
+                                *values.at(r.slot as usize) += blocks[r.src as usize] * r.scale;
+                            }
+                            let d = *values.at(diag[i]);
+                            ps[k] = d.try_inverse().unwrap_or_else(|| Mat3::identity() / d.trace().max(1e-300));
+                        }
+                    }
+                }
+            });
+        debug_assert_eq!(self.b.len(), n);
+    }
+}
+
+/// Concatenates per-row lists into one array plus row offsets.
+fn flatten<T>(rows: Vec<Vec<T>>) -> (Vec<T>, Vec<usize>) {
+    let mut ptr = vec![0];
+    let mut flat = Vec::new();
+    for r in rows {
+        flat.extend(r);
+        ptr.push(flat.len());
+    }
+    (flat, ptr)
+}

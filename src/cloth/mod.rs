@@ -1,0 +1,24 @@
+//! Cloth: particle state, force elements and material laws, the block-sparse implicit solver
+//! (Baraff & Witkin) and the explicit one, constraints (pins, attachments, contact hook),
+//! per-step statistics.
+
+pub mod assembly;
+pub mod bcsr;
+pub mod constraints;
+pub mod elements;
+pub mod error;
+pub mod material;
+pub mod model;
+pub mod parallel;
+pub mod pcg;
+pub mod simulation;
+pub mod state;
+pub mod stats;
+
+pub use constraints::{Attachment, ContactHook, Filter, Floor, Trajectory};
+pub use error::ClothError;
+pub use material::{Direction, FabricParameters, LinearMaterial, MaterialLaw};
+pub use model::ClothModel;
+pub use simulation::{Integrator, Simulation, SimulationParameters};
+pub use state::ClothState;
+pub use stats::StepStats;

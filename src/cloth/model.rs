@@ -1,0 +1,187 @@
+//! `ClothModel`: the fixed part of a cloth (mesh, masses, force elements, material), built
+//! once per topology from a grid or from any triangle mesh with rest coordinates.
+
+use std::sync::Arc;
+
+use super::elements::{BendLine, Hinge, Spring, SpringKind};
+use super::material::{Direction, FabricParameters, MaterialLaw};
+use super::ClothError;
+use crate::geometry::{grid_mesh, Topology, TriMesh};
+
+/// The fixed description of a cloth: its mesh, per-particle masses and areas, force elements
+/// and material law.
+#[derive(Debug, Clone)]
+pub struct ClothModel {
+    /// The mesh; `mesh.positions` are the initial positions.
+    pub mesh: TriMesh,
+    /// Particle masses (kg): areal density × the particle's share of the rest area.
+    pub mass: Vec<f64>,
+    /// Particle rest areas (m²), used for air drag.
+    pub area: Vec<f64>,
+    /// Stretch and shear springs.
+    pub springs: Vec<Spring>,
+    /// Grid-line bending elements.
+    pub bend_lines: Vec<BendLine>,
+    /// Dihedral bending hinges.
+    pub hinges: Vec<Hinge>,
+    /// The fabric parameters the model was built from.
+    pub fabric: FabricParameters,
+    /// The material law every element asks.
+    pub law: Arc<dyn MaterialLaw>,
+    /// Grid size (columns, rows) when built by [`ClothModel::grid`].
+    pub grid: Option<(usize, usize)>,
+}
+
+impl ClothModel {
+    /// A `width` × `height` rectangle of `nx` × `ny` particles, flat in the XY plane at z = 0
+    /// (see [`grid_mesh`]), with warp springs along x, weft springs along y, two shear
+    /// diagonals per quad and bending lines along both directions.
+    pub fn grid(
+        width: f64,
+        height: f64,
+        nx: usize,
+        ny: usize,
+        fabric: FabricParameters,
+    ) -> Result<Self, ClothError> {
+        fabric.validate().map_err(ClothError::Parameter)?;
+        let mesh = grid_mesh(width, height, nx, ny)?;
+        let (dx, dy) = (width / (nx - 1) as f64, height / (ny - 1) as f64);
+        let id = |i: usize, j: usize| i * nx + j;
+        // width of fabric a grid line stands for: half at the border
+        let wy = |i: usize| if i == 0 || i == ny - 1 { 0.5 * dy } else { dy };
+        let wx = |j: usize| if j == 0 || j == nx - 1 { 0.5 * dx } else { dx };
+        let mut springs = Vec::new();
+        let mut bend_lines = Vec::new();
+        let warp = SpringKind::Stretch { warp_weight: 1.0 };
+        let weft = SpringKind::Stretch { warp_weight: 0.0 };
+        let diag = (dx * dx + dy * dy).sqrt();
+        for i in 0..ny {
+            for j in 0..nx {
+                if j + 1 < nx {
+                    springs.push(Spring { a: id(i, j), b: id(i, j + 1), rest: dx, area: wy(i) * dx, kind: warp });
+                }
+                if i + 1 < ny {
+                    springs.push(Spring { a: id(i, j), b: id(i + 1, j), rest: dy, area: wx(j) * dy, kind: weft });
+                }
+                if i + 1 < ny && j + 1 < nx {
+                    let area = 0.25 * diag * diag;
+                    springs.push(Spring { a: id(i, j), b: id(i + 1, j + 1), rest: diag, area, kind: SpringKind::Shear });
+                    springs.push(Spring { a: id(i, j + 1), b: id(i + 1, j), rest: diag, area, kind: SpringKind::Shear });
+                }
+                if j >= 1 && j + 1 < nx {
+                    bend_lines.push(BendLine::new([id(i, j - 1), id(i, j), id(i, j + 1)], dx, dx, wy(i), Direction::Warp));
+                }
+                if i >= 1 && i + 1 < ny {
+                    bend_lines.push(BendLine::new([id(i - 1, j), id(i, j), id(i + 1, j)], dy, dy, wx(j), Direction::Weft));
+                }
+            }
+        }
+        let area = mesh.vertex_rest_areas();
+        let mass = area.iter().map(|a| a * fabric.density).collect();
+        Ok(ClothModel {
+            mesh,
+            mass,
+            area,
+            springs,
+            bend_lines,
+            hinges: Vec::new(),
+            law: Arc::new(fabric.linear_law()),
+            fabric,
+            grid: Some((nx, ny)),
+        })
+    }
+
+    /// A cloth from any triangle mesh whose `rest` holds the flat pattern coordinates:
+    /// a stretch spring per edge (stiffness blended between warp and weft by the edge's rest
+    /// direction), a shear spring across each interior edge (between the opposite vertices)
+    /// and a dihedral hinge per interior edge.
+    pub fn from_mesh(mesh: TriMesh, fabric: FabricParameters) -> Result<Self, ClothError> {
+        fabric.validate().map_err(ClothError::Parameter)?;
+        mesh.validate()?;
+        let topo = Topology::of(&mesh);
+        let n = mesh.vertex_count();
+        // summed area of triangles incident to each edge
+        let tri_area: Vec<f64> = (0..mesh.triangles.len()).map(|t| mesh.rest_area(t)).collect();
+        let mut edge_area = std::collections::BTreeMap::new();
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (p, q) = (tri[k], tri[(k + 1) % 3]);
+                *edge_area.entry((p.min(q), p.max(q))).or_insert(0.0) += tri_area[t];
+            }
+        }
+        let rest_vec = |p: usize, q: usize| {
+            let (a, b) = (mesh.rest[p], mesh.rest[q]);
+            (b[0] - a[0], b[1] - a[1])
+        };
+        let mut springs = Vec::with_capacity(topo.edges.len() + topo.hinges.len());
+        for e in &topo.edges {
+            let (du, dv) = rest_vec(e.a, e.b);
+            let l2 = du * du + dv * dv;
+            let rest = l2.sqrt();
+            if rest <= 0.0 {
+                return Err(ClothError::Parameter(format!("edge {}–{} has zero rest length", e.a, e.b)));
+            }
+            // k = E · ΣA / L0²: exact for axis-aligned edges of a right-triangle grid
+            let area = edge_area[&(e.a, e.b)];
+            springs.push(Spring { a: e.a, b: e.b, rest, area, kind: SpringKind::Stretch { warp_weight: du * du / l2 } });
+        }
+        let mut hinges = Vec::with_capacity(topo.hinges.len());
+        for h in &topo.hinges {
+            let a0 = edge_area[&(h.a.min(h.b), h.a.max(h.b))];
+            let (cu, cv) = rest_vec(h.c, h.d);
+            let cross = (cu * cu + cv * cv).sqrt();
+            if cross > 0.0 {
+                springs.push(Spring { a: h.c, b: h.d, rest: cross, area: 2.0 * a0 / 3.0, kind: SpringKind::Shear });
+            }
+            let (du, dv) = rest_vec(h.a, h.b);
+            let l2 = du * du + dv * dv;
+            // curvature direction is perpendicular to the edge: its warp share is dv²/l²
+            hinges.push(Hinge { nodes: [h.a, h.b, h.c, h.d], edge: l2.sqrt(), area: a0, warp_weight: dv * dv / l2 });
+        }
+        let area = mesh.vertex_rest_areas();
+        let mass = area.iter().map(|a| a * fabric.density).collect();
+        debug_assert_eq!(area.len(), n);
+        Ok(ClothModel {
+            mesh,
+            mass,
+            area,
+            springs,
+            bend_lines: Vec::new(),
+            hinges,
+            law: Arc::new(fabric.linear_law()),
+            fabric,
+            grid: None,
+        })
+    }
+
+    /// Number of particles.
+    pub fn particle_count(&self) -> usize {
+        self.mass.len()
+    }
+
+    /// Replaces the material law (e.g. a measured one) while keeping the elements.
+    pub fn set_law(&mut self, law: Arc<dyn MaterialLaw>) {
+        self.law = law;
+    }
+
+    /// All particle pairs coupled by some element (for the matrix pattern), unsorted.
+    pub fn coupled_pairs(&self) -> Vec<(usize, usize)> {
+        let mut pairs = Vec::new();
+        for s in &self.springs {
+            pairs.push((s.a, s.b));
+        }
+        for e in &self.bend_lines {
+            let [a, b, c] = e.nodes;
+            pairs.extend([(a, b), (b, c), (a, c)]);
+        }
+        for h in &self.hinges {
+            let n = h.nodes;
+            for p in 0..4 {
+                for q in p + 1..4 {
+                    pairs.push((n[p], n[q]));
+                }
+            }
+        }
+        pairs
+    }
+}

@@ -1,0 +1,31 @@
+//! Small helpers for deterministic parallel loops: fixed-size chunks, per-chunk partial sums
+//! reduced sequentially in chunk order, and a pointer wrapper for disjoint row writes.
+
+/// Items per parallel task for element and vector loops.
+pub const CHUNK: usize = 512;
+
+/// A raw pointer that may be shared across threads. Safety: the users write disjoint indices.
+#[derive(Clone, Copy)]
+pub struct SyncPtr<T>(pub *mut T);
+// SAFETY: only used for writes to disjoint elements, from one thread per element.
+unsafe impl<T> Sync for SyncPtr<T> {}
+// SAFETY: as above.
+unsafe impl<T> Send for SyncPtr<T> {}
+
+impl<T> SyncPtr<T> {
+    /// Pointer to element `i`. Safety: `i` in bounds, no other thread touches element `i`.
+    #[inline]
+    pub unsafe fn at(&self, i: usize) -> *mut T {
+        unsafe { self.0.add(i) }
+    }
+}
+
+/// Number of chunks of `CHUNK` items covering `n` items.
+pub fn chunks(n: usize, chunk: usize) -> usize {
+    n.div_ceil(chunk)
+}
+
+/// Sums `partials` in order (the deterministic reduction of per-chunk sums).
+pub fn ordered_sum(partials: &[f64]) -> f64 {
+    partials.iter().fold(0.0, |a, b| a + b)
+}

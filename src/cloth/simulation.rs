@@ -1,0 +1,388 @@
+//! `Simulation`: a cloth model, its state, constraints and contact hooks, stepped by the
+//! implicit (Baraff–Witkin) or the explicit (symplectic Euler) integrator. Every step checks
+//! for divergence and leaves the state untouched when it fails.
+
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use super::assembly::{Assembly, AssemblyInputs};
+use super::constraints::{Attachment, ContactHook, Filter, ParticleFilter, Trajectory};
+use super::model::ClothModel;
+use super::pcg::PcgWorkspace;
+use super::state::ClothState;
+use super::stats::StepStats;
+use super::ClothError;
+use crate::geometry::Vec3;
+
+/// Time integrator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Integrator {
+    /// Linearised backward Euler with the modified PCG (Baraff & Witkin).
+    Implicit,
+    /// Symplectic Euler with `explicit_substeps` substeps per step.
+    Explicit,
+}
+
+/// Settings of a simulation, SI units; every field settable on its own.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct SimulationParameters {
+    /// Step length (s).
+    pub dt: f64,
+    /// Which integrator advances the state.
+    pub integrator: Integrator,
+    /// Gravity (m/s²).
+    pub gravity: [f64; 3],
+    /// CG relative residual tolerance.
+    pub cg_tolerance: f64,
+    /// CG iteration cap.
+    pub cg_max_iterations: u32,
+    /// Start CG from the previous step's velocity change.
+    pub warm_start: bool,
+    /// Substeps per step for the explicit integrator.
+    pub explicit_substeps: u32,
+    /// A particle faster than this (m/s) means the simulation blew up.
+    pub max_speed: f64,
+}
+
+impl Default for SimulationParameters {
+    fn default() -> Self {
+        SimulationParameters {
+            dt: 1.0 / 120.0,
+            integrator: Integrator::Implicit,
+            gravity: [0.0, 0.0, -9.81],
+            cg_tolerance: 1e-3,
+            cg_max_iterations: 500,
+            warm_start: true,
+            explicit_substeps: 1,
+            max_speed: 200.0,
+        }
+    }
+}
+
+impl SimulationParameters {
+    /// Checks the values, naming the first bad parameter.
+    pub fn validate(&self) -> Result<(), ClothError> {
+        let bad = |name: &str, v: f64| ClothError::Parameter(format!("simulation parameter `{name}` is invalid: {v}"));
+        if !(self.dt.is_finite() && self.dt > 0.0) {
+            return Err(bad("dt", self.dt));
+        }
+        if !(self.cg_tolerance.is_finite() && self.cg_tolerance > 0.0) {
+            return Err(bad("cg_tolerance", self.cg_tolerance));
+        }
+        if !(self.max_speed > 0.0) {
+            return Err(bad("max_speed", self.max_speed));
+        }
+        if let Some(g) = self.gravity.iter().find(|g| !g.is_finite()) {
+            return Err(bad("gravity", *g));
+        }
+        if self.explicit_substeps == 0 {
+            return Err(bad("explicit_substeps", 0.0));
+        }
+        Ok(())
+    }
+}
+
+/// A running cloth simulation.
+#[derive(Debug)]
+pub struct Simulation {
+    /// The fixed model.
+    pub model: ClothModel,
+    /// The changing state.
+    pub state: ClothState,
+    /// Settings.
+    pub params: SimulationParameters,
+    /// Pins and moving attachments.
+    pub attachments: Vec<Attachment>,
+    /// Contact handlers consulted every step.
+    pub hooks: Vec<Box<dyn ContactHook>>,
+    /// Statistics of every step taken.
+    pub stats: Vec<StepStats>,
+    /// Steps whose CG solve did not reach the tolerance.
+    pub unconverged_steps: u64,
+    filter: Filter,
+    z: Vec<Vec3>,
+    dv: Vec<Vec3>,
+    x_save: Vec<Vec3>,
+    v_save: Vec<Vec3>,
+    asm: Assembly,
+    pcg: PcgWorkspace,
+}
+
+impl Simulation {
+    /// A simulation of `model`, at rest at its mesh positions.
+    pub fn new(model: ClothModel, params: SimulationParameters) -> Result<Self, ClothError> {
+        params.validate()?;
+        model.fabric.validate().map_err(ClothError::Parameter)?;
+        let n = model.particle_count();
+        let asm = Assembly::new(&model);
+        let state = ClothState::at_rest(model.mesh.positions.clone());
+        Ok(Simulation {
+            state,
+            params,
+            attachments: Vec::new(),
+            hooks: Vec::new(),
+            stats: Vec::new(),
+            unconverged_steps: 0,
+            filter: Filter::new(n),
+            z: vec![Vec3::zeros(); n],
+            dv: vec![Vec3::zeros(); n],
+            x_save: vec![Vec3::zeros(); n],
+            v_save: vec![Vec3::zeros(); n],
+            asm,
+            pcg: PcgWorkspace::new(n),
+            model,
+        })
+    }
+
+    /// Number of particles.
+    pub fn particle_count(&self) -> usize {
+        self.model.particle_count()
+    }
+
+    fn check_particles(&self, particles: &[usize]) -> Result<(), ClothError> {
+        let n = self.particle_count();
+        match particles.iter().find(|&&i| i >= n) {
+            Some(i) => Err(ClothError::Parameter(format!("particle index {i} out of range (cloth has {n})"))),
+            None => Ok(()),
+        }
+    }
+
+    /// Pins `particles` where they are now. Returns the attachment index.
+    pub fn pin(&mut self, particles: &[usize]) -> Result<usize, ClothError> {
+        self.attach(particles, Trajectory::Fixed)
+    }
+
+    /// Attaches `particles` to a target moving along `trajectory` from their current positions,
+    /// with the trajectory's clock starting now. Returns the attachment index.
+    pub fn attach(&mut self, particles: &[usize], trajectory: Trajectory) -> Result<usize, ClothError> {
+        self.check_particles(particles)?;
+        trajectory.validate().map_err(ClothError::Parameter)?;
+        let t0 = self.state.time;
+        let shift = trajectory.displacement(t0);
+        let anchors = particles.iter().map(|&i| (self.state.x[i] - shift).into()).collect();
+        self.attachments.push(Attachment { particles: particles.to_vec(), anchors, trajectory });
+        Ok(self.attachments.len() - 1)
+    }
+
+    /// Removes every attachment of `particles` (they become free).
+    pub fn release(&mut self, particles: &[usize]) {
+        for at in &mut self.attachments {
+            let keep: Vec<bool> = at.particles.iter().map(|i| !particles.contains(i)).collect();
+            let mut k = keep.iter();
+            at.particles.retain(|_| *k.next().unwrap());
+            let mut k = keep.iter();
+            at.anchors.retain(|_| *k.next().unwrap());
+        }
+        self.attachments.retain(|a| !a.particles.is_empty());
+    }
+
+    /// Target position of every attached particle at time `t`.
+    pub fn attachment_targets(&self, t: f64) -> Vec<(usize, Vec3)> {
+        let mut out = Vec::new();
+        for at in &self.attachments {
+            let d = at.trajectory.displacement(t);
+            for (k, &i) in at.particles.iter().enumerate() {
+                out.push((i, Vec3::from(at.anchors[k]) + d));
+            }
+        }
+        out
+    }
+
+    /// Adds a contact handler.
+    pub fn add_hook(&mut self, hook: Box<dyn ContactHook>) {
+        self.hooks.push(hook);
+    }
+
+    /// Energies of the current state: (kinetic, gravitational, elastic).
+    pub fn energy(&mut self) -> (f64, f64, f64) {
+        let inp = AssemblyInputs { dt: self.params.dt, gravity: Vec3::from(self.params.gravity), matrix: false };
+        let elastic = self.asm.assemble(&self.model, &self.state.x, &self.state.v, inp);
+        let (k, g) = self.kinetic_gravity();
+        (k, g, elastic)
+    }
+
+    fn kinetic_gravity(&self) -> (f64, f64) {
+        let gr = Vec3::from(self.params.gravity);
+        let (mut k, mut g) = (0.0, 0.0);
+        for i in 0..self.particle_count() {
+            let m = self.model.mass[i];
+            k += 0.5 * m * self.state.v[i].norm_squared();
+            g -= m * gr.dot(&self.state.x[i]);
+        }
+        (k, g)
+    }
+
+    fn build_filter(&mut self, t_end: f64, dt: f64) {
+        self.filter.clear();
+        for hook in &mut self.hooks {
+            hook.constrain(&self.state.x, &self.state.v, self.state.time, dt, &mut self.filter);
+        }
+        for at in &self.attachments {
+            let d = at.trajectory.displacement(t_end);
+            for (k, &i) in at.particles.iter().enumerate() {
+                self.filter.kind[i] = ParticleFilter::Fixed { target: Vec3::from(at.anchors[k]) + d };
+                self.filter.any = true;
+            }
+        }
+    }
+
+    /// Advances one step of `params.dt`.
+    pub fn step(&mut self) -> Result<StepStats, ClothError> {
+        self.params.validate()?;
+        let t_start = Instant::now();
+        self.x_save.copy_from_slice(&self.state.x);
+        self.v_save.copy_from_slice(&self.state.v);
+        let mut st = match self.params.integrator {
+            Integrator::Implicit => self.step_implicit(),
+            Integrator::Explicit => self.step_explicit(),
+        };
+        if let Err(cause) = self.check_state() {
+            let err = ClothError::Diverged { step: self.state.step, time: self.state.time, cause };
+            self.state.x.copy_from_slice(&self.x_save);
+            self.state.v.copy_from_slice(&self.v_save);
+            return Err(err);
+        }
+        st.step = self.state.step;
+        st.time = self.state.time;
+        st.step_ms = t_start.elapsed().as_secs_f64() * 1e3;
+        if !st.converged {
+            self.unconverged_steps += 1;
+        }
+        self.state.step += 1;
+        self.state.time += self.params.dt;
+        self.stats.push(st);
+        Ok(st)
+    }
+
+    fn check_state(&self) -> Result<(), String> {
+        let vmax2 = self.params.max_speed * self.params.max_speed;
+        for i in 0..self.particle_count() {
+            let (x, v) = (&self.state.x[i], &self.state.v[i]);
+            if !(x.iter().all(|c| c.is_finite()) && v.iter().all(|c| c.is_finite())) {
+                return Err(format!("particle {i} got a non-finite position or velocity (NaN)"));
+            }
+            if v.norm_squared() > vmax2 {
+                return Err(format!(
+                    "energy blow-up: particle {i} reached {:.3e} m/s (max_speed {} m/s); reduce dt or use the implicit integrator",
+                    v.norm(),
+                    self.params.max_speed
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn step_implicit(&mut self) -> StepStats {
+        let h = self.params.dt;
+        let t_end = self.state.time + h;
+        self.build_filter(t_end, h);
+        let (kinetic, gravity) = self.kinetic_gravity();
+        let t0 = Instant::now();
+        let inp = AssemblyInputs { dt: h, gravity: Vec3::from(self.params.gravity), matrix: true };
+        let elastic = self.asm.assemble(&self.model, &self.state.x, &self.state.v, inp);
+        let t1 = Instant::now();
+        for i in 0..self.particle_count() {
+            self.z[i] = self.filter.z(i, &self.state.x[i], &self.state.v[i], h);
+        }
+        if !self.params.warm_start {
+            self.dv.fill(Vec3::zeros());
+        }
+        let res = self.pcg.solve(
+            &self.asm.a,
+            &self.asm.b,
+            &self.asm.pinv,
+            &self.filter,
+            &self.z,
+            &mut self.dv,
+            self.params.cg_tolerance,
+            self.params.cg_max_iterations,
+        );
+        let t2 = Instant::now();
+        for i in 0..self.particle_count() {
+            self.state.v[i] += self.dv[i];
+            self.state.x[i] += self.state.v[i] * h;
+        }
+        self.finish_constraints();
+        StepStats {
+            kinetic,
+            gravity,
+            elastic,
+            total: kinetic + gravity + elastic,
+            cg_iterations: res.iterations,
+            residual: res.residual,
+            converged: res.converged,
+            assemble_ms: (t1 - t0).as_secs_f64() * 1e3,
+            solve_ms: (t2 - t1).as_secs_f64() * 1e3,
+            ..Default::default()
+        }
+    }
+
+    /// Snaps fixed particles exactly onto their targets, then lets hooks correct positions.
+    fn finish_constraints(&mut self) {
+        for i in 0..self.particle_count() {
+            if let ParticleFilter::Fixed { target } = self.filter.kind[i] {
+                self.state.x[i] = target;
+            }
+        }
+        for hook in &mut self.hooks {
+            hook.correct(&mut self.state.x, &mut self.state.v);
+        }
+    }
+
+    fn step_explicit(&mut self) -> StepStats {
+        let sub = self.params.explicit_substeps.max(1);
+        let h = self.params.dt / sub as f64;
+        let gravity = Vec3::from(self.params.gravity);
+        let (kinetic, grav) = self.kinetic_gravity();
+        let mut elastic0 = 0.0;
+        let t0 = Instant::now();
+        for k in 0..sub {
+            let t_end = self.state.time + h * (k + 1) as f64;
+            self.build_filter(t_end, h);
+            let inp = AssemblyInputs { dt: h, gravity, matrix: false };
+            let e = self.asm.assemble(&self.model, &self.state.x, &self.state.v, inp);
+            if k == 0 {
+                elastic0 = e;
+            }
+            for i in 0..self.particle_count() {
+                let vn = self.state.v[i] + self.asm.b[i] * (h / self.model.mass[i]);
+                // constrained directions take the prescribed velocity
+                let z = self.filter.z(i, &self.state.x[i], &self.state.v[i], h);
+                self.state.v[i] = self.filter.apply(i, vn) + (self.state.v[i] + z - self.filter.apply(i, self.state.v[i] + z));
+                self.state.x[i] += self.state.v[i] * h;
+            }
+            self.finish_constraints();
+        }
+        StepStats {
+            kinetic,
+            gravity: grav,
+            elastic: elastic0,
+            total: kinetic + grav + elastic0,
+            assemble_ms: t0.elapsed().as_secs_f64() * 1e3,
+            converged: true,
+            ..Default::default()
+        }
+    }
+
+    /// Runs `steps` steps, calling `each` after every step; stops at the first error.
+    pub fn run_steps(
+        &mut self,
+        steps: u64,
+        mut each: impl FnMut(&Simulation, &StepStats) -> Result<(), ClothError>,
+    ) -> Result<(), ClothError> {
+        self.stats.reserve(steps as usize);
+        for _ in 0..steps {
+            let st = self.step()?;
+            each(self, &st)?;
+        }
+        Ok(())
+    }
+
+    /// Number of steps needed to cover `seconds`.
+    pub fn steps_for(&self, seconds: f64) -> u64 {
+        (seconds / self.params.dt - 1e-9).ceil().max(0.0) as u64
+    }
+}

@@ -1,0 +1,19 @@
+//! Geometry: triangle meshes with rest (pattern) coordinates, grid generators, edge/hinge
+//! adjacency, and mesh file I/O (OBJ read/write, binary glTF write).
+
+pub mod error;
+pub mod gltf;
+pub mod grid;
+pub mod mesh;
+pub mod obj;
+pub mod topology;
+
+pub use error::GeometryError;
+pub use grid::grid_mesh;
+pub use mesh::TriMesh;
+pub use topology::{Edge, Hinge, Topology};
+
+/// Three-vector of f64, SI units (metres, m/s, newtons).
+pub type Vec3 = nalgebra::Vector3<f64>;
+/// 3×3 matrix of f64.
+pub type Mat3 = nalgebra::Matrix3<f64>;
