@@ -29,3 +29,18 @@ pub fn chunks(n: usize, chunk: usize) -> usize {
 pub fn ordered_sum(partials: &[f64]) -> f64 {
     partials.iter().fold(0.0, |a, b| a + b)
 }
+
+/// Below this many particles, loops run on the calling thread: handing work to other threads
+/// costs more than it saves.
+pub const PAR_MIN: usize = 3000;
+
+/// Calls `f(i)` for `i in 0..count`, in parallel when `par`.
+#[inline]
+pub fn for_each_index<F: Fn(usize) + Sync + Send>(count: usize, par: bool, f: F) {
+    use rayon::prelude::*;
+    if par {
+        (0..count).into_par_iter().for_each(f);
+    } else {
+        (0..count).for_each(f);
+    }
+}

@@ -6,6 +6,7 @@ use rayon::prelude::*;
 
 use super::bcsr::Bcsr3;
 use super::constraints::Filter;
+use super::multigrid::Multigrid;
 use super::parallel::{chunks, ordered_sum, CHUNK};
 use crate::geometry::{Mat3, Vec3};
 
@@ -16,6 +17,7 @@ pub struct PcgWorkspace {
     c: Vec<Vec3>,
     q: Vec<Vec3>,
     s: Vec<Vec3>,
+    s_old: Vec<Vec3>,
     p1: Vec<f64>,
     p2: Vec<f64>,
 }
@@ -36,17 +38,18 @@ impl PcgWorkspace {
     pub fn new(n: usize) -> Self {
         let z = vec![Vec3::zeros(); n];
         let nc = chunks(n.max(1), CHUNK);
-        PcgWorkspace { r: z.clone(), c: z.clone(), q: z.clone(), s: z, p1: vec![0.0; nc], p2: vec![0.0; nc] }
+        PcgWorkspace { r: z.clone(), c: z.clone(), q: z.clone(), s: z.clone(), s_old: z, p1: vec![0.0; nc], p2: vec![0.0; nc] }
     }
 
     /// Solves for `dv`. On entry `dv` holds the initial guess for the free directions (e.g. the
-    /// previous step's solution); `z` the prescribed change in constrained directions.
+    /// previous step's solution); `z` the prescribed change in constrained directions. The
+    /// direction update uses the Polak–Ribière β, so a variable preconditioner is safe.
     #[allow(clippy::too_many_arguments)]
     pub fn solve(
         &mut self,
         a: &Bcsr3,
         b: &[Vec3],
-        pinv: &[Mat3],
+        precond: &mut Preconditioner,
         filter: &Filter,
         z: &[Vec3],
         dv: &mut [Vec3],
@@ -55,7 +58,7 @@ impl PcgWorkspace {
     ) -> PcgResult {
         let n = b.len();
         let nc = chunks(n, CHUNK);
-        let (r, c, q, s) = (&mut self.r, &mut self.c, &mut self.q, &mut self.s);
+        let (r, c, q, s, s_old) = (&mut self.r, &mut self.c, &mut self.q, &mut self.s, &mut self.s_old);
         let (p1, p2) = (&mut self.p1[..nc], &mut self.p2[..nc]);
         // Δv = S Δv0 + z
         dv.par_chunks_mut(CHUNK).enumerate().for_each(|(ci, d)| {
@@ -78,83 +81,135 @@ impl PcgWorkspace {
             *p = acc;
         });
         let bnorm2 = ordered_sum(p1);
-        // r = S(b − A Δv), c = S P⁻¹ r, δ = r·c, ρ = r·r
+        // r = S(b − A Δv), ρ = r·r
         let dvr: &[Vec3] = dv;
-        r.par_chunks_mut(CHUNK)
-            .zip(c.par_chunks_mut(CHUNK))
-            .zip(p1.par_iter_mut().zip(p2.par_iter_mut()))
-            .enumerate()
-            .for_each(|(ci, ((rs, cs), (pd, pr)))| {
-                let (mut d, mut rr) = (0.0, 0.0);
-                for k in 0..rs.len() {
-                    let i = ci * CHUNK + k;
-                    let ri = filter.apply(i, b[i] - a.row_times(i, dvr));
-                    let ci_ = filter.apply(i, pinv[i] * ri);
-                    d += ri.dot(&ci_);
-                    rr += ri.norm_squared();
-                    rs[k] = ri;
-                    cs[k] = ci_;
-                }
-                *pd = d;
-                *pr = rr;
-            });
-        let mut delta = ordered_sum(p1);
+        r.par_chunks_mut(CHUNK).zip(p2.par_iter_mut()).enumerate().for_each(|(ci, (rs, pr))| {
+            let mut rr = 0.0;
+            for k in 0..rs.len() {
+                let i = ci * CHUNK + k;
+                let ri = filter.apply(i, b[i] - a.row_times(i, dvr));
+                rr += ri.norm_squared();
+                rs[k] = ri;
+            }
+            *pr = rr;
+        });
         let mut rr = ordered_sum(p2);
         let target = tolerance * tolerance * bnorm2;
         let mut it = 0;
-        while rr > target && it < max_iterations && delta > 0.0 {
-            // q = S A c, cq = c·q
-            let cr: &[Vec3] = c;
-            q.par_chunks_mut(CHUNK).zip(p1.par_iter_mut()).enumerate().for_each(|(ci, (qs, p))| {
-                let mut acc = 0.0;
-                for k in 0..qs.len() {
-                    let i = ci * CHUNK + k;
-                    let qi = filter.apply(i, a.row_times(i, cr));
-                    acc += cr[i].dot(&qi);
-                    qs[k] = qi;
-                }
-                *p = acc;
-            });
-            let cq = ordered_sum(p1);
-            if cq <= 0.0 {
-                break;
-            }
-            let alpha = delta / cq;
-            // Δv += α c; r −= α q; s = P⁻¹ r; δ' = r·s; ρ = r·r
-            dv.par_chunks_mut(CHUNK)
-                .zip(r.par_chunks_mut(CHUNK))
-                .zip(s.par_chunks_mut(CHUNK))
-                .zip(p1.par_iter_mut().zip(p2.par_iter_mut()))
-                .enumerate()
-                .for_each(|(ci, (((ds, rs), ss), (pd, pr)))| {
-                    let (mut d, mut rrl) = (0.0, 0.0);
-                    for k in 0..ds.len() {
+        if rr > target && max_iterations > 0 {
+            precond.apply(a, r, s);
+            let (delta, _) = dots(r, s, s_old, filter, c, 0.0, p1, p2, false);
+            let mut delta = delta;
+            while rr > target && it < max_iterations && delta > 0.0 {
+                // q = S A c, cq = c·q
+                let cr: &[Vec3] = c;
+                q.par_chunks_mut(CHUNK).zip(p1.par_iter_mut()).enumerate().for_each(|(ci, (qs, p))| {
+                    let mut acc = 0.0;
+                    for k in 0..qs.len() {
                         let i = ci * CHUNK + k;
-                        ds[k] += cr[i] * alpha;
-                        let ri = rs[k] - q[i] * alpha;
-                        rs[k] = ri;
-                        let si = pinv[i] * ri;
-                        ss[k] = si;
-                        d += ri.dot(&si);
-                        rrl += ri.norm_squared();
+                        let qi = filter.apply(i, a.row_times(i, cr));
+                        acc += cr[i].dot(&qi);
+                        qs[k] = qi;
                     }
-                    *pd = d;
-                    *pr = rrl;
+                    *p = acc;
                 });
-            let dnew = ordered_sum(p1);
-            rr = ordered_sum(p2);
-            let beta = dnew / delta;
-            delta = dnew;
-            let sr: &[Vec3] = s;
-            c.par_chunks_mut(CHUNK).enumerate().for_each(|(ci, cs)| {
-                for k in 0..cs.len() {
-                    let i = ci * CHUNK + k;
-                    cs[k] = filter.apply(i, sr[i] + cs[k] * beta);
+                let cq = ordered_sum(p1);
+                if cq <= 0.0 {
+                    break;
                 }
-            });
-            it += 1;
+                let alpha = delta / cq;
+                // Δv += α c; r −= α q; ρ = r·r
+                dv.par_chunks_mut(CHUNK)
+                    .zip(r.par_chunks_mut(CHUNK))
+                    .zip(p2.par_iter_mut())
+                    .enumerate()
+                    .for_each(|(ci, ((ds, rs), pr))| {
+                        let mut rrl = 0.0;
+                        for k in 0..ds.len() {
+                            let i = ci * CHUNK + k;
+                            ds[k] += cr[i] * alpha;
+                            let ri = rs[k] - q[i] * alpha;
+                            rs[k] = ri;
+                            rrl += ri.norm_squared();
+                        }
+                        *pr = rrl;
+                    });
+                rr = ordered_sum(p2);
+                it += 1;
+                if rr <= target {
+                    break;
+                }
+                std::mem::swap(s, s_old);
+                precond.apply(a, r, s);
+                let (dnew, beta) = dots(r, s, s_old, filter, c, delta, p1, p2, true);
+                let _ = beta;
+                delta = dnew;
+            }
         }
         let residual = if bnorm2 > 0.0 { (rr / bnorm2).sqrt() } else { 0.0 };
         PcgResult { iterations: it, residual, converged: rr <= target }
     }
+}
+
+/// How the residual is preconditioned.
+#[derive(Debug)]
+pub enum Preconditioner<'a> {
+    /// Inverse 3×3 diagonal blocks.
+    BlockJacobi(&'a [Mat3]),
+    /// One multigrid V-cycle.
+    Multigrid(&'a mut Multigrid),
+}
+
+impl Preconditioner<'_> {
+    /// s = P⁻¹ r.
+    pub fn apply(&mut self, a: &Bcsr3, r: &[Vec3], s: &mut [Vec3]) {
+        match self {
+            Preconditioner::BlockJacobi(pinv) => {
+                s.par_chunks_mut(CHUNK).enumerate().for_each(|(ci, ss)| {
+                    for k in 0..ss.len() {
+                        let i = ci * CHUNK + k;
+                        ss[k] = pinv[i] * r[i];
+                    }
+                });
+            }
+            Preconditioner::Multigrid(mg) => mg.apply(a, r, s),
+        }
+    }
+}
+
+/// δ = r·s and, when `update`, the Polak–Ribière direction c = S(s + β c) with
+/// β = (r·s − r·s_old)/δ_old; otherwise c = S s. Returns (δ, β).
+#[allow(clippy::too_many_arguments)]
+fn dots(
+    r: &[Vec3],
+    s: &[Vec3],
+    s_old: &[Vec3],
+    filter: &Filter,
+    c: &mut [Vec3],
+    delta_old: f64,
+    p1: &mut [f64],
+    p2: &mut [f64],
+    update: bool,
+) -> (f64, f64) {
+    let n = r.len();
+    p1.par_iter_mut().zip(p2.par_iter_mut()).enumerate().for_each(|(ci, (a, b))| {
+        let (mut x, mut y) = (0.0, 0.0);
+        for i in ci * CHUNK..((ci + 1) * CHUNK).min(n) {
+            x += r[i].dot(&s[i]);
+            if update {
+                y += r[i].dot(&s_old[i]);
+            }
+        }
+        *a = x;
+        *b = y;
+    });
+    let dnew = ordered_sum(p1);
+    let beta = if update { ((dnew - ordered_sum(p2)) / delta_old).max(0.0) } else { 0.0 };
+    c.par_chunks_mut(CHUNK).enumerate().for_each(|(ci, cs)| {
+        for k in 0..cs.len() {
+            let i = ci * CHUNK + k;
+            cs[k] = filter.apply(i, s[i] + cs[k] * beta);
+        }
+    });
+    (dnew, beta)
 }

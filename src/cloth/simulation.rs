@@ -9,7 +9,8 @@ use serde::{Deserialize, Serialize};
 use super::assembly::{Assembly, AssemblyInputs};
 use super::constraints::{Attachment, ContactHook, Filter, ParticleFilter, Trajectory};
 use super::model::ClothModel;
-use super::pcg::PcgWorkspace;
+use super::multigrid::Multigrid;
+use super::pcg::{PcgWorkspace, Preconditioner};
 use super::state::ClothState;
 use super::stats::StepStats;
 use super::ClothError;
@@ -23,6 +24,18 @@ pub enum Integrator {
     Implicit,
     /// Symplectic Euler with `explicit_substeps` substeps per step.
     Explicit,
+}
+
+/// Which preconditioner the implicit solve uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PreconditionerKind {
+    /// Multigrid on grid cloths of at least 16 × 16 particles, block-Jacobi otherwise.
+    Auto,
+    /// Inverse diagonal 3×3 blocks.
+    BlockJacobi,
+    /// Geometric multigrid V-cycle with line smoothing (grid cloths only).
+    Multigrid,
 }
 
 /// Settings of a simulation, SI units; every field settable on its own.
@@ -45,6 +58,8 @@ pub struct SimulationParameters {
     pub explicit_substeps: u32,
     /// A particle faster than this (m/s) means the simulation blew up.
     pub max_speed: f64,
+    /// Preconditioner of the implicit solve.
+    pub preconditioner: PreconditionerKind,
 }
 
 impl Default for SimulationParameters {
@@ -58,6 +73,7 @@ impl Default for SimulationParameters {
             warm_start: true,
             explicit_substeps: 1,
             max_speed: 200.0,
+            preconditioner: PreconditionerKind::Auto,
         }
     }
 }
@@ -109,6 +125,8 @@ pub struct Simulation {
     v_save: Vec<Vec3>,
     asm: Assembly,
     pcg: PcgWorkspace,
+    mg: Option<Multigrid>,
+    fixed: Vec<bool>,
 }
 
 impl Simulation {
@@ -119,6 +137,12 @@ impl Simulation {
         let n = model.particle_count();
         let asm = Assembly::new(&model);
         let state = ClothState::at_rest(model.mesh.positions.clone());
+        let mg = match (params.preconditioner, model.grid) {
+            (PreconditionerKind::BlockJacobi, _) => None,
+            (PreconditionerKind::Auto, Some((nx, ny))) if nx.min(ny) >= 16 => Some(Multigrid::new(&model, &asm.a)?),
+            (PreconditionerKind::Auto, _) => None,
+            (PreconditionerKind::Multigrid, _) => Some(Multigrid::new(&model, &asm.a)?),
+        };
         Ok(Simulation {
             state,
             params,
@@ -133,8 +157,15 @@ impl Simulation {
             v_save: vec![Vec3::zeros(); n],
             asm,
             pcg: PcgWorkspace::new(n),
+            mg,
+            fixed: vec![false; n],
             model,
         })
+    }
+
+    /// Multigrid time spent so far: (setup s, V-cycles s, V-cycle count); `None` without multigrid.
+    pub fn multigrid_timing(&self) -> Option<(f64, f64, u64)> {
+        self.mg.as_ref().map(|m| m.timing)
     }
 
     /// Number of particles.
@@ -231,6 +262,11 @@ impl Simulation {
 
     /// Advances one step of `params.dt`.
     pub fn step(&mut self) -> Result<StepStats, ClothError> {
+        // run on a pool thread so the many small parallel loops of a step fork cheaply
+        rayon::scope(|_| self.step_inner())
+    }
+
+    fn step_inner(&mut self) -> Result<StepStats, ClothError> {
         self.params.validate()?;
         let t_start = Instant::now();
         self.x_save.copy_from_slice(&self.state.x);
@@ -290,10 +326,20 @@ impl Simulation {
         if !self.params.warm_start {
             self.dv.fill(Vec3::zeros());
         }
+        let mut precond = match self.mg.as_mut() {
+            Some(mg) => {
+                for (f, k) in self.fixed.iter_mut().zip(&self.filter.kind) {
+                    *f = matches!(k, ParticleFilter::Fixed { .. });
+                }
+                mg.setup(&self.asm.a, &self.state.x, &self.state.v, &self.fixed, inp);
+                Preconditioner::Multigrid(mg)
+            }
+            None => Preconditioner::BlockJacobi(&self.asm.pinv),
+        };
         let res = self.pcg.solve(
             &self.asm.a,
             &self.asm.b,
-            &self.asm.pinv,
+            &mut precond,
             &self.filter,
             &self.z,
             &mut self.dv,

@@ -1,0 +1,212 @@
+//! Block line Gauss–Seidel along the warp and weft lines of a grid cloth: the smoother of the
+//! multigrid preconditioner. Stretch springs couple particles strongly along their own line
+//! only, and bending couples particles two apart, so point smoothers stall or diverge on them.
+//! Each line's block-pentadiagonal system (3×3 blocks, neighbours one and two apart) is
+//! factorised exactly once per step; lines are swept in three colours (lines three apart never
+//! share an element), so lines of one colour are solved in parallel. No allocation per step.
+
+use super::bcsr::Bcsr3;
+use super::parallel::{for_each_index, SyncPtr, PAR_MIN};
+use crate::geometry::{Mat3, Vec3};
+
+/// Which family of grid lines.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LineDir {
+    /// Rows: particles i*nx + j for j = 0..nx (the warp).
+    Warp,
+    /// Columns: particles i*nx + j for i = 0..ny (the weft).
+    Weft,
+}
+
+/// Banded block LU factors of every line of one direction.
+#[derive(Debug, Clone)]
+struct Factors {
+    /// Slots of blocks (k, previous) and (k, previous of previous) on the line, or usize::MAX.
+    prev1: Vec<usize>,
+    prev2: Vec<usize>,
+    /// Inverse pivots.
+    g: Vec<Mat3>,
+    /// Multipliers for the previous and the one before.
+    l1: Vec<Mat3>,
+    l2: Vec<Mat3>,
+    /// Upper blocks to the next and the one after.
+    u1: Vec<Mat3>,
+    u2: Vec<Mat3>,
+}
+
+/// Factorised line systems of one grid for both directions, plus scratch.
+#[derive(Debug, Clone)]
+pub struct LineSolver {
+    nx: usize,
+    ny: usize,
+    warp: Factors,
+    weft: Factors,
+    y: Vec<Vec3>,
+}
+
+const NONE: usize = usize::MAX;
+
+impl LineSolver {
+    /// Prepares the solver for an `nx` × `ny` grid whose matrix pattern is `a`.
+    pub fn new(a: &Bcsr3, nx: usize, ny: usize) -> Self {
+        let n = nx * ny;
+        let slot = |k: usize, back: usize, ok: bool| if ok { a.slot(k, k - back).unwrap_or(NONE) } else { NONE };
+        let factors = |stride: usize, pos: &dyn Fn(usize) -> usize| {
+            let z = vec![Mat3::zeros(); n];
+            Factors {
+                prev1: (0..n).map(|k| slot(k, stride, pos(k) >= 1)).collect(),
+                prev2: (0..n).map(|k| slot(k, 2 * stride, pos(k) >= 2)).collect(),
+                g: z.clone(),
+                l1: z.clone(),
+                l2: z.clone(),
+                u1: z.clone(),
+                u2: z,
+            }
+        };
+        let warp = factors(1, &|k| k % nx);
+        let weft = factors(nx, &|k| k / nx);
+        LineSolver { nx, ny, warp, weft, y: vec![Vec3::zeros(); n] }
+    }
+
+    #[inline]
+    fn line(nx: usize, ny: usize, dir: LineDir, line: usize) -> (usize, usize, usize) {
+        match dir {
+            LineDir::Warp => (line * nx, 1, nx),
+            LineDir::Weft => (line, nx, ny),
+        }
+    }
+
+    fn line_count(&self, dir: LineDir) -> usize {
+        match dir {
+            LineDir::Warp => self.ny,
+            LineDir::Weft => self.nx,
+        }
+    }
+
+    /// Factorises the line systems of `a`; `fixed` particles get identity rows (no correction).
+    pub fn factor(&mut self, a: &Bcsr3, fixed: &[bool]) {
+        let (nx, ny) = (self.nx, self.ny);
+        for dir in [LineDir::Warp, LineDir::Weft] {
+            let f = match dir {
+                LineDir::Warp => &mut self.warp,
+                LineDir::Weft => &mut self.weft,
+            };
+            let nl = match dir {
+                LineDir::Warp => ny,
+                LineDir::Weft => nx,
+            };
+            let (gp, l1p, l2p, u1p, u2p) = (
+                SyncPtr(f.g.as_mut_ptr()),
+                SyncPtr(f.l1.as_mut_ptr()),
+                SyncPtr(f.l2.as_mut_ptr()),
+                SyncPtr(f.u1.as_mut_ptr()),
+                SyncPtr(f.u2.as_mut_ptr()),
+            );
+            let (prev1, prev2) = (&f.prev1, &f.prev2);
+            // block (k, k − back) of the line system, zero when either particle is fixed
+            let blk = |k: usize, back: usize, slot: usize| {
+                if slot == NONE || fixed[k] || fixed[k - back] {
+                    Mat3::zeros()
+                } else {
+                    a.values[slot]
+                }
+            };
+            for_each_index(nl, nx * ny >= PAR_MIN, |line| {
+                let (first, s, len) = Self::line(nx, ny, dir, line);
+                // SAFETY: each particle belongs to exactly one line of this direction; reads of
+                // earlier particles of the same line happen after their writes in this thread.
+                unsafe {
+                    for t in 0..len {
+                        let k = first + t * s;
+                        let mut a2 = if t >= 2 { blk(k, 2 * s, prev2[k]) } else { Mat3::zeros() };
+                        let mut a1 = if t >= 1 { blk(k, s, prev1[k]) } else { Mat3::zeros() };
+                        let mut d = if fixed[k] { Mat3::identity() } else { a.values[a.diag[k]] };
+                        let _ = &mut a2;
+                        // eliminate column k − 2s
+                        let l2 = if t >= 2 { a2 * *gp.at(k - 2 * s) } else { Mat3::zeros() };
+                        if t >= 2 {
+                            a1 -= l2 * *u1p.at(k - 2 * s);
+                            d -= l2 * *u2p.at(k - 2 * s);
+                        }
+                        // eliminate column k − s
+                        let l1 = if t >= 1 { a1 * *gp.at(k - s) } else { Mat3::zeros() };
+                        if t >= 1 {
+                            d -= l1 * *u1p.at(k - s);
+                        }
+                        let g = d.try_inverse().unwrap_or_else(Mat3::identity);
+                        // upper blocks (k, k + s) and (k, k + 2s) = transposes of the lower ones
+                        // of the later rows (A is symmetric), minus the fill from column k − s
+                        let mut u1 = if t + 1 < len { blk(k + s, s, prev1[k + s]).transpose() } else { Mat3::zeros() };
+                        let u2 = if t + 2 < len { blk(k + 2 * s, 2 * s, prev2[k + 2 * s]).transpose() } else { Mat3::zeros() };
+                        if t >= 1 && t + 1 < len {
+                            u1 -= l1 * *u2p.at(k - s);
+                        }
+                        *gp.at(k) = g;
+                        *l1p.at(k) = l1;
+                        *l2p.at(k) = l2;
+                        *u1p.at(k) = u1;
+                        *u2p.at(k) = u2;
+                    }
+                }
+            });
+        }
+    }
+
+    /// One block Gauss–Seidel sweep over all lines of `dir`: for each of three colours in
+    /// `order`, the residual `r − A e` of that colour's lines is solved exactly on each line
+    /// and added to `e`. Fixed particles keep a zero correction.
+    pub fn sweep(&mut self, a: &Bcsr3, dir: LineDir, r: &[Vec3], e: &mut [Vec3], fixed: &[bool], order: [usize; 3]) {
+        let (nx, ny) = (self.nx, self.ny);
+        let nl = self.line_count(dir);
+        let f = match dir {
+            LineDir::Warp => &self.warp,
+            LineDir::Weft => &self.weft,
+        };
+        let yp = SyncPtr(self.y.as_mut_ptr());
+        let ep = SyncPtr(e.as_mut_ptr());
+        for color in order {
+            let count = (nl + 2 - color) / 3;
+            for_each_index(count, nx * ny >= PAR_MIN, |m| {
+                let line = color + 3 * m;
+                let (first, s, len) = Self::line(nx, ny, dir, line);
+                // SAFETY: lines of one colour are three apart, so no element couples two of
+                // them: each task writes its own line's e and y and reads e of other colours only.
+                unsafe {
+                    // residual of the line, then forward elimination in place
+                    for t in 0..len {
+                        let k = first + t * s;
+                        let mut d = if fixed[k] { Vec3::zeros() } else { r[k] - row_times_ptr(a, k, ep.0) };
+                        if t >= 1 {
+                            d -= f.l1[k] * *yp.at(k - s);
+                        }
+                        if t >= 2 {
+                            d -= f.l2[k] * *yp.at(k - 2 * s);
+                        }
+                        *yp.at(k) = d;
+                    }
+                    let (mut x1, mut x2) = (Vec3::zeros(), Vec3::zeros());
+                    for t in (0..len).rev() {
+                        let k = first + t * s;
+                        let xk = f.g[k] * (*yp.at(k) - f.u1[k] * x1 - f.u2[k] * x2);
+                        *ep.at(k) += xk;
+                        x2 = x1;
+                        x1 = xk;
+                    }
+                }
+            });
+        }
+    }
+}
+
+/// Row `i` of `A x` reading `x` through a raw pointer (other threads write other rows' lines).
+///
+/// # Safety
+/// `x` must point to `a.rows()` vectors, none of which another thread writes for columns of row `i`.
+#[inline]
+unsafe fn row_times_ptr(a: &Bcsr3, i: usize, x: *const Vec3) -> Vec3 {
+    let mut acc = Vec3::zeros();
+    for k in a.row_ptr[i]..a.row_ptr[i + 1] {
+        acc += a.values[k] * unsafe { *x.add(a.cols[k] as usize) };
+    }
+    acc
+}
