@@ -39,12 +39,17 @@ pub struct BenchResult {
     pub unconverged: u64,
     /// Worker threads.
     pub threads: usize,
+    /// Multigrid levels (1 = block-Jacobi only).
+    pub levels: usize,
+    /// Mean V-cycles per substep.
+    pub vcycles: f64,
 }
 
 /// Runs the hang scene at `n` × `n` for `frames` frames of 5 substeps, `runs` times after one
 /// warm-up run, and returns the median.
 pub fn bench_hang(n: usize, frames: u32, runs: usize) -> Result<BenchResult, ClothError> {
     let substeps = 5;
+    let runs = runs.max(1);
     let mut results = Vec::new();
     for r in 0..=runs {
         let mut sim = scenes::hang(n)?;
@@ -59,7 +64,8 @@ pub fn bench_hang(n: usize, frames: u32, runs: usize) -> Result<BenchResult, Clo
             let imax = s.iter().map(|x| x.cg_iterations).max().unwrap_or(0);
             let am = s.iter().map(|x| x.assemble_ms).sum::<f64>() / k;
             let sm = s.iter().map(|x| x.solve_ms).sum::<f64>() / k;
-            results.push((ms, iters, imax, am, sm, sim.unconverged_steps, sim.params.cg_tolerance));
+            let vc = sim.multigrid_timing().map_or(0.0, |t| t.2 as f64 / k);
+            results.push((ms, iters, imax, am, sm, sim.unconverged_steps, sim.params.cg_tolerance, vc, sim.multigrid_levels()));
         }
     }
     let mut runs_ms: Vec<f64> = results.iter().map(|r| r.0).collect();
@@ -82,5 +88,7 @@ pub fn bench_hang(n: usize, frames: u32, runs: usize) -> Result<BenchResult, Clo
         cg_tolerance: med.6,
         unconverged: med.5,
         threads: rayon::current_num_threads(),
+        levels: med.8,
+        vcycles: med.7,
     })
 }

@@ -130,10 +130,12 @@ fn implicit_is_stable_on_stiff_cloth_where_explicit_diverges() {
 
 #[test]
 fn unconverged_solves_are_reported() {
-    let params = SimulationParameters { cg_tolerance: 1e-12, cg_max_iterations: 2, ..Default::default() };
-    let mut sim = corner_pinned(16, FabricParameters::default(), params);
+    let mut sim = corner_pinned(16, FabricParameters::default(), SimulationParameters::default());
+    sim.run_steps(30, |_, _| Ok(())).unwrap();
+    sim.params.cg_tolerance = 1e-14;
+    sim.params.cg_max_iterations = 1;
     let st = sim.step().unwrap();
-    assert!(!st.converged && st.cg_iterations == 2);
+    assert!(!st.converged && st.cg_iterations == 1 && st.residual > 1e-14, "{st:?}");
     assert_eq!(sim.unconverged_steps, 1);
 }
 

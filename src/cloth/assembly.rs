@@ -254,6 +254,8 @@ impl Assembly {
         let h = inp.dt;
         let matrix = inp.matrix;
         let values = SyncPtr(self.a.values.as_mut_ptr());
+        let mirror = !self.a.values32.is_empty();
+        let values32 = SyncPtr(self.a.values32.as_mut_ptr());
         let (row_ptr, diag) = (&self.a.row_ptr, &self.a.diag);
         let (recs, rec_ptr, grecs, grec_ptr) = (&self.recs, &self.rec_ptr, &self.grecs, &self.grec_ptr);
         let (blocks, g) = (&self.blocks, &self.g);
@@ -283,6 +285,11 @@ impl Assembly {
                             *values.at(diag[i]) = Mat3::identity() * (m + h * da);
                             for r in &recs[rec_ptr[i]..rec_ptr[i + 1]] {
                                 *values.at(r.slot as usize) += blocks[r.src as usize] * r.scale;
+                            }
+                            if mirror {
+                                for s in row_ptr[i]..row_ptr[i + 1] {
+                                    *values32.at(s) = (*values.at(s)).cast::<f32>();
+                                }
                             }
                             let d = *values.at(diag[i]);
                             ps[k] = d.try_inverse().unwrap_or_else(|| Mat3::identity() / d.trace().max(1e-300));

@@ -20,7 +20,13 @@ pub struct Bcsr3 {
     pub values: Vec<Mat3>,
     /// Index of the diagonal block of each row.
     pub diag: Vec<usize>,
+    /// Optional single-precision mirror of `values` (empty unless enabled), read by the
+    /// multigrid smoother where memory traffic, not precision, is the cost.
+    pub values32: Vec<Mat3f>,
 }
+
+/// 3×3 single-precision block.
+pub type Mat3f = nalgebra::Matrix3<f32>;
 
 impl Bcsr3 {
     /// Builds the symmetric pattern of an `n`-row matrix holding every diagonal block and both
@@ -46,7 +52,7 @@ impl Bcsr3 {
             row_ptr.push(cols.len());
         }
         let values = vec![Mat3::zeros(); cols.len()];
-        Bcsr3 { row_ptr, cols, values, diag }
+        Bcsr3 { row_ptr, cols, values, diag, values32: Vec::new() }
     }
 
     /// Number of block rows.
@@ -73,6 +79,25 @@ impl Bcsr3 {
                 *yi = self.row_times(base + k, x);
             }
         });
+    }
+
+    /// Allocates the single-precision mirror (filled by whoever fills `values`).
+    pub fn enable_mirror32(&mut self) {
+        self.values32 = vec![Mat3f::zeros(); self.values.len()];
+    }
+
+    /// Row `i` of `A x` with the single-precision mirror, reading `x` through a raw pointer.
+    ///
+    /// # Safety
+    /// `x` must point to `rows()` vectors; no other thread may write the entries row `i` reads.
+    #[inline]
+    pub unsafe fn row_times32_ptr(&self, i: usize, x: *const Vec3) -> Vec3 {
+        let mut acc = Vec3::zeros();
+        for k in self.row_ptr[i]..self.row_ptr[i + 1] {
+            let xj = unsafe { *x.add(self.cols[k] as usize) };
+            acc += self.values32[k].cast::<f64>() * xj;
+        }
+        acc
     }
 
     /// Row `i` of `A x`.

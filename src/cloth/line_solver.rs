@@ -5,7 +5,7 @@
 //! factorised exactly once per step; lines are swept in three colours (lines three apart never
 //! share an element), so lines of one colour are solved in parallel. No allocation per step.
 
-use super::bcsr::Bcsr3;
+use super::bcsr::{Bcsr3, Mat3f};
 use super::parallel::{for_each_index, SyncPtr, PAR_MIN};
 use crate::geometry::{Mat3, Vec3};
 
@@ -24,14 +24,14 @@ struct Factors {
     /// Slots of blocks (k, previous) and (k, previous of previous) on the line, or usize::MAX.
     prev1: Vec<usize>,
     prev2: Vec<usize>,
-    /// Inverse pivots.
-    g: Vec<Mat3>,
+    /// Inverse pivots (single precision: a preconditioner, bounded by memory traffic).
+    g: Vec<Mat3f>,
     /// Multipliers for the previous and the one before.
-    l1: Vec<Mat3>,
-    l2: Vec<Mat3>,
+    l1: Vec<Mat3f>,
+    l2: Vec<Mat3f>,
     /// Upper blocks to the next and the one after.
-    u1: Vec<Mat3>,
-    u2: Vec<Mat3>,
+    u1: Vec<Mat3f>,
+    u2: Vec<Mat3f>,
 }
 
 /// Factorised line systems of one grid for both directions, plus scratch.
@@ -52,7 +52,7 @@ impl LineSolver {
         let n = nx * ny;
         let slot = |k: usize, back: usize, ok: bool| if ok { a.slot(k, k - back).unwrap_or(NONE) } else { NONE };
         let factors = |stride: usize, pos: &dyn Fn(usize) -> usize| {
-            let z = vec![Mat3::zeros(); n];
+            let z = vec![Mat3f::zeros(); n];
             Factors {
                 prev1: (0..n).map(|k| slot(k, stride, pos(k) >= 1)).collect(),
                 prev2: (0..n).map(|k| slot(k, 2 * stride, pos(k) >= 2)).collect(),
@@ -113,40 +113,42 @@ impl LineSolver {
             };
             for_each_index(nl, nx * ny >= PAR_MIN, |line| {
                 let (first, s, len) = Self::line(nx, ny, dir, line);
-                // SAFETY: each particle belongs to exactly one line of this direction; reads of
-                // earlier particles of the same line happen after their writes in this thread.
-                unsafe {
-                    for t in 0..len {
-                        let k = first + t * s;
-                        let mut a2 = if t >= 2 { blk(k, 2 * s, prev2[k]) } else { Mat3::zeros() };
-                        let mut a1 = if t >= 1 { blk(k, s, prev1[k]) } else { Mat3::zeros() };
-                        let mut d = if fixed[k] { Mat3::identity() } else { a.values[a.diag[k]] };
-                        let _ = &mut a2;
-                        // eliminate column k − 2s
-                        let l2 = if t >= 2 { a2 * *gp.at(k - 2 * s) } else { Mat3::zeros() };
-                        if t >= 2 {
-                            a1 -= l2 * *u1p.at(k - 2 * s);
-                            d -= l2 * *u2p.at(k - 2 * s);
-                        }
-                        // eliminate column k − s
-                        let l1 = if t >= 1 { a1 * *gp.at(k - s) } else { Mat3::zeros() };
-                        if t >= 1 {
-                            d -= l1 * *u1p.at(k - s);
-                        }
-                        let g = d.try_inverse().unwrap_or_else(Mat3::identity);
-                        // upper blocks (k, k + s) and (k, k + 2s) = transposes of the lower ones
-                        // of the later rows (A is symmetric), minus the fill from column k − s
-                        let mut u1 = if t + 1 < len { blk(k + s, s, prev1[k + s]).transpose() } else { Mat3::zeros() };
-                        let u2 = if t + 2 < len { blk(k + 2 * s, 2 * s, prev2[k + 2 * s]).transpose() } else { Mat3::zeros() };
-                        if t >= 1 && t + 1 < len {
-                            u1 -= l1 * *u2p.at(k - s);
-                        }
-                        *gp.at(k) = g;
-                        *l1p.at(k) = l1;
-                        *l2p.at(k) = l2;
-                        *u1p.at(k) = u1;
-                        *u2p.at(k) = u2;
+                // factors of the two previous rows, kept in double precision
+                let (mut g_1, mut u1_1, mut u2_1) = (Mat3::zeros(), Mat3::zeros(), Mat3::zeros());
+                let (mut g_2, mut u1_2, mut u2_2) = (Mat3::zeros(), Mat3::zeros(), Mat3::zeros());
+                for t in 0..len {
+                    let k = first + t * s;
+                    let a2 = if t >= 2 { blk(k, 2 * s, prev2[k]) } else { Mat3::zeros() };
+                    let mut a1 = if t >= 1 { blk(k, s, prev1[k]) } else { Mat3::zeros() };
+                    let mut d = if fixed[k] { Mat3::identity() } else { a.values[a.diag[k]] };
+                    // eliminate column k − 2s, then column k − s
+                    let l2 = if t >= 2 { a2 * g_2 } else { Mat3::zeros() };
+                    if t >= 2 {
+                        a1 -= l2 * u1_2;
+                        d -= l2 * u2_2;
                     }
+                    let l1 = if t >= 1 { a1 * g_1 } else { Mat3::zeros() };
+                    if t >= 1 {
+                        d -= l1 * u1_1;
+                    }
+                    let g = d.try_inverse().unwrap_or_else(Mat3::identity);
+                    // upper blocks (k, k + s), (k, k + 2s): transposes of later rows' lower blocks
+                    // (A is symmetric), minus the fill from column k − s
+                    let mut u1 = if t + 1 < len { blk(k + s, s, prev1[k + s]).transpose() } else { Mat3::zeros() };
+                    let u2 = if t + 2 < len { blk(k + 2 * s, 2 * s, prev2[k + 2 * s]).transpose() } else { Mat3::zeros() };
+                    if t >= 1 && t + 1 < len {
+                        u1 -= l1 * u2_1;
+                    }
+                    // SAFETY: each particle belongs to exactly one line of this direction.
+                    unsafe {
+                        *gp.at(k) = g.cast::<f32>();
+                        *l1p.at(k) = l1.cast::<f32>();
+                        *l2p.at(k) = l2.cast::<f32>();
+                        *u1p.at(k) = u1.cast::<f32>();
+                        *u2p.at(k) = u2.cast::<f32>();
+                    }
+                    (g_2, u1_2, u2_2) = (g_1, u1_1, u2_1);
+                    (g_1, u1_1, u2_1) = (g, u1, u2);
                 }
             });
         }
@@ -175,19 +177,19 @@ impl LineSolver {
                     // residual of the line, then forward elimination in place
                     for t in 0..len {
                         let k = first + t * s;
-                        let mut d = if fixed[k] { Vec3::zeros() } else { r[k] - row_times_ptr(a, k, ep.0) };
+                        let mut d = if fixed[k] { Vec3::zeros() } else { r[k] - a.row_times32_ptr(k, ep.0) };
                         if t >= 1 {
-                            d -= f.l1[k] * *yp.at(k - s);
+                            d -= f.l1[k].cast::<f64>() * *yp.at(k - s);
                         }
                         if t >= 2 {
-                            d -= f.l2[k] * *yp.at(k - 2 * s);
+                            d -= f.l2[k].cast::<f64>() * *yp.at(k - 2 * s);
                         }
                         *yp.at(k) = d;
                     }
                     let (mut x1, mut x2) = (Vec3::zeros(), Vec3::zeros());
                     for t in (0..len).rev() {
                         let k = first + t * s;
-                        let xk = f.g[k] * (*yp.at(k) - f.u1[k] * x1 - f.u2[k] * x2);
+                        let xk = f.g[k].cast::<f64>() * (*yp.at(k) - f.u1[k].cast::<f64>() * x1 - f.u2[k].cast::<f64>() * x2);
                         *ep.at(k) += xk;
                         x2 = x1;
                         x1 = xk;
@@ -196,17 +198,4 @@ impl LineSolver {
             });
         }
     }
-}
-
-/// Row `i` of `A x` reading `x` through a raw pointer (other threads write other rows' lines).
-///
-/// # Safety
-/// `x` must point to `a.rows()` vectors, none of which another thread writes for columns of row `i`.
-#[inline]
-unsafe fn row_times_ptr(a: &Bcsr3, i: usize, x: *const Vec3) -> Vec3 {
-    let mut acc = Vec3::zeros();
-    for k in a.row_ptr[i]..a.row_ptr[i + 1] {
-        acc += a.values[k] * unsafe { *x.add(a.cols[k] as usize) };
-    }
-    acc
 }

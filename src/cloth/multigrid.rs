@@ -129,8 +129,6 @@ impl Transfer {
 /// One coarse level: its own cloth model and assembly, and scratch vectors.
 #[derive(Debug)]
 struct Level {
-    nx: usize,
-    ny: usize,
     /// `None` on the finest level (which uses the simulation's own matrix).
     model: Option<ClothModel>,
     asm: Option<Assembly>,
@@ -169,8 +167,6 @@ impl Multigrid {
         let (w, h) = grid_extent(model, nx, ny);
         let n = nx * ny;
         let mut levels = vec![Level {
-            nx,
-            ny,
             model: None,
             asm: None,
             lines: LineSolver::new(a, nx, ny),
@@ -189,15 +185,14 @@ impl Multigrid {
             let cm = ClothModel::grid(w, h, cx, cy, model.fabric)?;
             let mut cm = cm;
             cm.set_law(model.law.clone());
-            let asm = Assembly::new(&cm);
+            let mut asm = Assembly::new(&cm);
+            asm.a.enable_mirror32();
             let nc = cx * cy;
             let lines = LineSolver::new(&asm.a, cx, cy);
             levels.last_mut().expect("level").to_fine = None;
             let to_fine = Transfer::new((fx, fy), (cx, cy));
             levels.last_mut().expect("level").to_fine = Some(to_fine);
             levels.push(Level {
-                nx: cx,
-                ny: cy,
                 model: Some(cm),
                 asm: Some(asm),
                 lines,
@@ -310,7 +305,8 @@ fn residual(a: &Bcsr3, r: &[Vec3], e: &[Vec3], d: &mut [Vec3], fixed: &[bool]) {
         for i in c * ROW_CHUNK..((c + 1) * ROW_CHUNK).min(n) {
             // SAFETY: each index is written by one task only.
             let out = unsafe { &mut *dp.at(i) };
-            *out = if fixed[i] { Vec3::zeros() } else { r[i] - a.row_times(i, e) };
+            // SAFETY: e is only read here.
+            *out = if fixed[i] { Vec3::zeros() } else { r[i] - unsafe { a.row_times32_ptr(i, e.as_ptr()) } };
         }
     });
 }

@@ -135,7 +135,7 @@ impl Simulation {
         params.validate()?;
         model.fabric.validate().map_err(ClothError::Parameter)?;
         let n = model.particle_count();
-        let asm = Assembly::new(&model);
+        let mut asm = Assembly::new(&model);
         let state = ClothState::at_rest(model.mesh.positions.clone());
         let mg = match (params.preconditioner, model.grid) {
             (PreconditionerKind::BlockJacobi, _) => None,
@@ -143,6 +143,9 @@ impl Simulation {
             (PreconditionerKind::Auto, _) => None,
             (PreconditionerKind::Multigrid, _) => Some(Multigrid::new(&model, &asm.a)?),
         };
+        if mg.is_some() {
+            asm.a.enable_mirror32();
+        }
         Ok(Simulation {
             state,
             params,
@@ -166,6 +169,11 @@ impl Simulation {
     /// Multigrid time spent so far: (setup s, V-cycles s, V-cycle count); `None` without multigrid.
     pub fn multigrid_timing(&self) -> Option<(f64, f64, u64)> {
         self.mg.as_ref().map(|m| m.timing)
+    }
+
+    /// Levels of the multigrid hierarchy (1 when block-Jacobi preconditions).
+    pub fn multigrid_levels(&self) -> usize {
+        self.mg.as_ref().map_or(1, |m| m.depth())
     }
 
     /// Number of particles.
