@@ -170,7 +170,8 @@ impl Hinge {
         let (n1h, n2h) = (n1 / l1.sqrt(), n2 / l2.sqrt());
         let sin = n1h.cross(&n2h).dot(&(e / el));
         let cos = n1h.dot(&n2h);
-        let theta = sin.atan2(cos);
+        // sign chosen so that the gradients below are those of θ
+        let theta = -sin.atan2(cos);
         let gc = n1 * (el / l1);
         let gd = n2 * (el / l2);
         let ga = n1 * ((xc - xb).dot(&e) / el / l1) + n2 * ((xd - xb).dot(&e) / el / l2);
