@@ -65,14 +65,26 @@ pub fn bench_hang(n: usize, frames: u32, runs: usize) -> Result<BenchResult, Clo
             let am = s.iter().map(|x| x.assemble_ms).sum::<f64>() / k;
             let sm = s.iter().map(|x| x.solve_ms).sum::<f64>() / k;
             let vc = sim.multigrid_timing().map_or(0.0, |t| t.2 as f64 / k);
-            results.push((ms, iters, imax, am, sm, sim.unconverged_steps, sim.params.cg_tolerance, vc, sim.multigrid_levels()));
+            results.push((
+                ms,
+                iters,
+                imax,
+                am,
+                sm,
+                sim.unconverged_steps,
+                sim.params.cg_tolerance,
+                vc,
+                sim.multigrid_levels(),
+            ));
         }
     }
     let mut runs_ms: Vec<f64> = results.iter().map(|r| r.0).collect();
     let mut sorted = results.clone();
     sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
     let med = sorted[sorted.len() / 2];
-    runs_ms.iter_mut().for_each(|x| *x = (*x * 1000.0).round() / 1000.0);
+    runs_ms
+        .iter_mut()
+        .for_each(|x| *x = (*x * 1000.0).round() / 1000.0);
     Ok(BenchResult {
         scene: "hang".into(),
         n,

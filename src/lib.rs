@@ -6,8 +6,10 @@
 //! `script` (feature `scripting`) registers all of it with a Rhai engine.
 #![warn(missing_docs)]
 
+pub mod bench;
 pub mod cloth;
 pub mod geometry;
 pub mod render;
-pub mod bench;
 pub mod scenes;
+#[cfg(feature = "scripting")]
+pub mod script;

@@ -1,21 +1,128 @@
-use clap::Parser;
+//! The `emilion` command: the demo scene (no arguments), `run` a script, the `repl`, API `doc`s
+//! and the `bench` benchmark.
 
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Context;
+use clap::{Parser, Subcommand};
+
+/// Cloth simulation with measured fabrics, scripted in Rhai.
 #[derive(Parser)]
+#[command(name = "emilion", version, about)]
 struct Cli {
-    #[arg(long, default_value = "32,64,128,256")]
-    sizes: String,
-    #[arg(long, default_value_t = 5)]
-    runs: usize,
-    #[arg(long, default_value_t = 50)]
-    frames: u32,
+    #[command(subcommand)]
+    command: Option<Command>,
+    /// Output folder of the demo scene (no subcommand).
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
 }
 
-fn main() -> anyhow::Result<()> {
-    let cli = Cli::parse();
-    for s in cli.sizes.split(',') {
-        let n: usize = s.trim().parse()?;
-        let r = emilion::bench::bench_hang(n, cli.frames, cli.runs)?;
-        println!("{}", serde_json::to_string(&r)?);
+#[derive(Subcommand)]
+enum Command {
+    /// Runs a Rhai script.
+    Run {
+        /// The script file.
+        file: PathBuf,
+        /// Defines a script constant before running: `--set key=value` (int, float, bool or string).
+        #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_set)]
+        sets: Vec<(String, String)>,
+    },
+    /// Interactive Rhai prompt with every emilion function.
+    Repl {
+        /// A script to run first (its variables and functions stay available).
+        init: Option<PathBuf>,
+    },
+    /// Writes the script API reference (api.md, api.json) into a folder.
+    Doc {
+        /// Output folder.
+        out_dir: PathBuf,
+    },
+    /// Benchmarks the hanging-cloth scene; prints one JSON line per size.
+    Bench {
+        /// Particles per side, comma-separated.
+        #[arg(long, default_value = "32,64,128,256")]
+        sizes: String,
+        /// Timed runs per size (after one warm-up run).
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+        /// Frames per run (5 substeps each).
+        #[arg(long, default_value_t = 50)]
+        frames: u32,
+    },
+}
+
+fn parse_set(s: &str) -> Result<(String, String), String> {
+    match s.split_once('=') {
+        Some((k, v)) if !k.trim().is_empty() => Ok((k.trim().to_string(), v.to_string())),
+        _ => Err(format!("expected KEY=VALUE, got `{s}`")),
     }
-    Ok(())
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: Cli) -> anyhow::Result<ExitCode> {
+    match cli.command {
+        None => {
+            for p in emilion::scenes::demo(&cli.out).context("demo scene")? {
+                println!("{}", p.display());
+            }
+        }
+        Some(Command::Bench {
+            sizes,
+            runs,
+            frames,
+        }) => {
+            for s in sizes.split(',') {
+                let n: usize = s
+                    .trim()
+                    .parse()
+                    .with_context(|| format!("bad size `{s}`"))?;
+                let r = emilion::bench::bench_hang(n, frames, runs)?;
+                println!("{}", serde_json::to_string(&r)?);
+            }
+        }
+        Some(cmd) => return scripting(cmd),
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(feature = "scripting")]
+fn scripting(cmd: Command) -> anyhow::Result<ExitCode> {
+    use emilion::script;
+    match cmd {
+        Command::Run { file, sets } => {
+            if let Err(e) = script::run_file(&file, &sets) {
+                eprintln!("{e}");
+                return Ok(ExitCode::FAILURE);
+            }
+        }
+        Command::Repl { init } => {
+            script::repl::repl(init.as_deref()).map_err(anyhow::Error::msg)?
+        }
+        Command::Doc { out_dir } => {
+            for p in script::docs::write_docs(&out_dir)
+                .with_context(|| format!("writing {}", out_dir.display()))?
+            {
+                println!("{}", p.display());
+            }
+        }
+        Command::Bench { .. } => unreachable!("handled in run"),
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(not(feature = "scripting"))]
+fn scripting(_: Command) -> anyhow::Result<ExitCode> {
+    eprintln!("emilion was built without the `scripting` feature: run, repl and doc are disabled");
+    Ok(ExitCode::from(2))
 }

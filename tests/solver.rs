@@ -1,7 +1,9 @@
 //! Solver tests: the multigrid-preconditioned CG gives the same answer as block-Jacobi CG,
 //! iteration counts stay flat with resolution, and runs are bit-for-bit deterministic.
 
-use emilion::cloth::{ClothModel, FabricParameters, PreconditionerKind, Simulation, SimulationParameters};
+use emilion::cloth::{
+    ClothModel, FabricParameters, PreconditionerKind, Simulation, SimulationParameters,
+};
 
 fn hang(n: usize, params: SimulationParameters) -> Simulation {
     let model = ClothModel::grid(1.0, 1.0, n, n, FabricParameters::default()).unwrap();
@@ -12,9 +14,25 @@ fn hang(n: usize, params: SimulationParameters) -> Simulation {
 
 #[test]
 fn multigrid_and_block_jacobi_agree() {
-    let tight = SimulationParameters { cg_tolerance: 1e-10, cg_max_iterations: 5000, ..Default::default() };
-    let mut mg = hang(24, SimulationParameters { preconditioner: PreconditionerKind::Multigrid, ..tight });
-    let mut bj = hang(24, SimulationParameters { preconditioner: PreconditionerKind::BlockJacobi, ..tight });
+    let tight = SimulationParameters {
+        cg_tolerance: 1e-10,
+        cg_max_iterations: 5000,
+        ..Default::default()
+    };
+    let mut mg = hang(
+        24,
+        SimulationParameters {
+            preconditioner: PreconditionerKind::Multigrid,
+            ..tight
+        },
+    );
+    let mut bj = hang(
+        24,
+        SimulationParameters {
+            preconditioner: PreconditionerKind::BlockJacobi,
+            ..tight
+        },
+    );
     assert!(mg.multigrid_levels() > 1 && bj.multigrid_levels() == 1);
     let (mut it_mg, mut it_bj) = (0, 0);
     for _ in 0..60 {
@@ -24,9 +42,21 @@ fn multigrid_and_block_jacobi_agree() {
         it_mg += a.cg_iterations;
         it_bj += b.cg_iterations;
     }
-    let dev = mg.state.x.iter().zip(&bj.state.x).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
-    assert!(dev < 1e-6, "multigrid and block-Jacobi solutions differ by {dev} m");
-    assert!(it_mg * 5 < it_bj, "multigrid {it_mg} vs block-Jacobi {it_bj} iterations");
+    let dev = mg
+        .state
+        .x
+        .iter()
+        .zip(&bj.state.x)
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max);
+    assert!(
+        dev < 1e-6,
+        "multigrid and block-Jacobi solutions differ by {dev} m"
+    );
+    assert!(
+        it_mg * 5 < it_bj,
+        "multigrid {it_mg} vs block-Jacobi {it_bj} iterations"
+    );
 }
 
 #[test]
@@ -34,11 +64,19 @@ fn multigrid_iterations_do_not_grow_with_resolution() {
     let mean_iters = |n: usize| {
         let mut sim = hang(n, SimulationParameters::default());
         sim.run_steps(60, |_, st| {
-            assert!(st.converged, "n = {n}, step {}: residual {}", st.step, st.residual);
+            assert!(
+                st.converged,
+                "n = {n}, step {}: residual {}",
+                st.step, st.residual
+            );
             Ok(())
         })
         .unwrap();
-        sim.stats.iter().map(|s| s.cg_iterations as f64).sum::<f64>() / sim.stats.len() as f64
+        sim.stats
+            .iter()
+            .map(|s| s.cg_iterations as f64)
+            .sum::<f64>()
+            / sim.stats.len() as f64
     };
     let (a, b) = (mean_iters(24), mean_iters(96));
     eprintln!("mean CG iterations: 24² {a:.2}, 96² {b:.2}");
@@ -53,6 +91,12 @@ fn runs_are_bit_identical() {
         sim.state
     };
     let (a, b) = (run(), run());
-    assert!(a.x.iter().zip(&b.x).all(|(p, q)| p.iter().zip(q.iter()).all(|(u, v)| u.to_bits() == v.to_bits())));
-    assert!(a.v.iter().zip(&b.v).all(|(p, q)| p.iter().zip(q.iter()).all(|(u, v)| u.to_bits() == v.to_bits())));
+    assert!(a.x.iter().zip(&b.x).all(|(p, q)| p
+        .iter()
+        .zip(q.iter())
+        .all(|(u, v)| u.to_bits() == v.to_bits())));
+    assert!(a.v.iter().zip(&b.v).all(|(p, q)| p
+        .iter()
+        .zip(q.iter())
+        .all(|(u, v)| u.to_bits() == v.to_bits())));
 }

@@ -71,8 +71,16 @@ impl Assembly {
         let slot = |i: usize, j: usize| a.slot(i, j).expect("pair in pattern") as u32;
         for (s, sp) in model.springs.iter().enumerate() {
             for (me, other, gi) in [(sp.a, sp.b, 2 * s), (sp.b, sp.a, 2 * s + 1)] {
-                rows[me].push(Rec { slot: slot(me, me), src: s as u32, scale: 1.0 });
-                rows[me].push(Rec { slot: slot(me, other), src: s as u32, scale: -1.0 });
+                rows[me].push(Rec {
+                    slot: slot(me, me),
+                    src: s as u32,
+                    scale: 1.0,
+                });
+                rows[me].push(Rec {
+                    slot: slot(me, other),
+                    src: s as u32,
+                    scale: -1.0,
+                });
                 grows[me].push(gi as u32);
             }
         }
@@ -126,17 +134,33 @@ impl Assembly {
     /// Evaluates all elements at (x, v) and assembles. In matrix mode, fills `a`, `b`, `pinv`
     /// for the implicit step of length `dt`; in force-only mode, `b` receives the total force.
     /// Returns the elastic energy at x.
-    pub fn assemble(&mut self, model: &ClothModel, x: &[Vec3], v: &[Vec3], inp: AssemblyInputs) -> f64 {
+    pub fn assemble(
+        &mut self,
+        model: &ClothModel,
+        x: &[Vec3],
+        v: &[Vec3],
+        inp: AssemblyInputs,
+    ) -> f64 {
         let energy = self.element_pass(model, x, v, inp);
         self.gather_pass(model, v, inp);
         energy
     }
 
-    fn element_pass(&mut self, model: &ClothModel, x: &[Vec3], v: &[Vec3], inp: AssemblyInputs) -> f64 {
+    fn element_pass(
+        &mut self,
+        model: &ClothModel,
+        x: &[Vec3],
+        v: &[Vec3],
+        inp: AssemblyInputs,
+    ) -> f64 {
         let law = &*model.law;
         let fab = &model.fabric;
         // factors: g = hf·(f + f_damp) − hk·(K v); blocks = bk·K (+ bc·K_axial)
-        let (hf, hk) = if inp.matrix { (inp.dt, inp.dt * inp.dt) } else { (1.0, 0.0) };
+        let (hf, hk) = if inp.matrix {
+            (inp.dt, inp.dt * inp.dt)
+        } else {
+            (1.0, 0.0)
+        };
         let (beta_s, beta_b) = (fab.stretch_damping, fab.bend_damping);
         let ns = model.springs.len();
         let nb = model.bend_lines.len();
@@ -233,10 +257,13 @@ impl Assembly {
                         let stiff = dm * el.edge * el.edge / el.area;
                         let gv: f64 = (0..4).map(|m| grad[m].dot(&v[el.nodes[m]])).sum();
                         for m in 0..4 {
-                            g[4 * k + m] = -grad[m] * (dedtheta * hf + stiff * gv * (beta_b * hf + hk));
+                            g[4 * k + m] =
+                                -grad[m] * (dedtheta * hf + stiff * gv * (beta_b * hf + hk));
                             if matrix {
                                 for q in 0..4 {
-                                    bl[16 * k + 4 * m + q] = grad[m] * grad[q].transpose() * (stiff * (hk + inp.dt * beta_b));
+                                    bl[16 * k + 4 * m + q] = grad[m]
+                                        * grad[q].transpose()
+                                        * (stiff * (hk + inp.dt * beta_b));
                                 }
                             }
                         }
@@ -257,7 +284,8 @@ impl Assembly {
         let mirror = !self.a.values32.is_empty();
         let values32 = SyncPtr(self.a.values32.as_mut_ptr());
         let (row_ptr, diag) = (&self.a.row_ptr, &self.a.diag);
-        let (recs, rec_ptr, grecs, grec_ptr) = (&self.recs, &self.rec_ptr, &self.grecs, &self.grec_ptr);
+        let (recs, rec_ptr, grecs, grec_ptr) =
+            (&self.recs, &self.rec_ptr, &self.grecs, &self.grec_ptr);
         let (blocks, g) = (&self.blocks, &self.g);
         self.b
             .par_chunks_mut(CHUNK)
@@ -292,7 +320,9 @@ impl Assembly {
                                 }
                             }
                             let d = *values.at(diag[i]);
-                            ps[k] = d.try_inverse().unwrap_or_else(|| Mat3::identity() / d.trace().max(1e-300));
+                            ps[k] = d
+                                .try_inverse()
+                                .unwrap_or_else(|| Mat3::identity() / d.trace().max(1e-300));
                         }
                     }
                 }

@@ -52,7 +52,13 @@ impl Bcsr3 {
             row_ptr.push(cols.len());
         }
         let values = vec![Mat3::zeros(); cols.len()];
-        Bcsr3 { row_ptr, cols, values, diag, values32: Vec::new() }
+        Bcsr3 {
+            row_ptr,
+            cols,
+            values,
+            diag,
+            values32: Vec::new(),
+        }
     }
 
     /// Number of block rows.
@@ -68,7 +74,10 @@ impl Bcsr3 {
     /// Index of block `(i, j)` in `values`, if it is in the pattern.
     pub fn slot(&self, i: usize, j: usize) -> Option<usize> {
         let (s, e) = (self.row_ptr[i], self.row_ptr[i + 1]);
-        self.cols[s..e].binary_search(&(j as u32)).ok().map(|k| s + k)
+        self.cols[s..e]
+            .binary_search(&(j as u32))
+            .ok()
+            .map(|k| s + k)
     }
 
     /// `y = A x`, parallel over row chunks, bit-identical whatever the thread count.
@@ -129,7 +138,9 @@ mod tests {
                 dense[i][j] = m;
             }
         }
-        let x: Vec<Vec3> = (0..n).map(|i| Vec3::new(i as f64, 1.0, -(i as f64) * 0.5)).collect();
+        let x: Vec<Vec3> = (0..n)
+            .map(|i| Vec3::new(i as f64, 1.0, -(i as f64) * 0.5))
+            .collect();
         let mut y = vec![Vec3::zeros(); n];
         a.mul_vec(&x, &mut y);
         for i in 0..n {

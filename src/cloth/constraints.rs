@@ -50,9 +50,10 @@ impl Trajectory {
                 }
                 Vec3::from(k[k.len() - 1].1)
             }
-            Trajectory::Oscillation { amplitude, frequency } => {
-                Vec3::from(*amplitude) * (2.0 * std::f64::consts::PI * frequency * t).sin()
-            }
+            Trajectory::Oscillation {
+                amplitude,
+                frequency,
+            } => Vec3::from(*amplitude) * (2.0 * std::f64::consts::PI * frequency * t).sin(),
         }
     }
 
@@ -62,7 +63,10 @@ impl Trajectory {
         match self {
             Trajectory::Fixed => Ok(()),
             Trajectory::Linear { velocity } if finite3(velocity) => Ok(()),
-            Trajectory::Oscillation { amplitude, frequency } if finite3(amplitude) && frequency.is_finite() => Ok(()),
+            Trajectory::Oscillation {
+                amplitude,
+                frequency,
+            } if finite3(amplitude) && frequency.is_finite() => Ok(()),
             Trajectory::Keyframes(k) => {
                 if k.iter().any(|(t, p)| !t.is_finite() || !finite3(p)) {
                     return Err("keyframes must be finite".into());
@@ -120,7 +124,10 @@ pub struct Filter {
 impl Filter {
     /// A filter of `n` free particles.
     pub fn new(n: usize) -> Self {
-        Filter { kind: vec![ParticleFilter::Free; n], any: false }
+        Filter {
+            kind: vec![ParticleFilter::Free; n],
+            any: false,
+        }
     }
 
     /// Frees every particle.

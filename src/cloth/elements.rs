@@ -80,8 +80,18 @@ impl Spring {
         };
         let tension = self.area * f / self.rest;
         let axial = self.area * df / (self.rest * self.rest);
-        let transverse = if len > 0.0 { (tension / len).max(0.0) } else { 0.0 };
-        SpringEval { dir, tension, axial, transverse, energy: self.area * w }
+        let transverse = if len > 0.0 {
+            (tension / len).max(0.0)
+        } else {
+            0.0
+        };
+        SpringEval {
+            dir,
+            tension,
+            axial,
+            transverse,
+            energy: self.area * w,
+        }
     }
 }
 
@@ -113,7 +123,12 @@ impl BendLine {
     pub fn new(nodes: [usize; 3], d1: f64, d2: f64, width: f64, dir: Direction) -> Self {
         let ca = 2.0 / (d1 * (d1 + d2));
         let cc = 2.0 / (d2 * (d1 + d2));
-        BendLine { nodes, coef: [ca, -(ca + cc), cc], area: width * 0.5 * (d1 + d2), dir }
+        BendLine {
+            nodes,
+            coef: [ca, -(ca + cc), cc],
+            area: width * 0.5 * (d1 + d2),
+            dir,
+        }
     }
 
     /// Evaluates: (curvature vector q, M(κ), dM/dκ, energy). The force on node m is
@@ -127,7 +142,11 @@ impl BendLine {
         let (m, dm, w) = law.bending(self.dir, kappa);
         if kappa < 1e-12 {
             // M/κ → M'(0) as κ → 0
-            return (q * (self.area * dm), Mat3::identity() * (self.area * dm), self.area * w);
+            return (
+                q * (self.area * dm),
+                Mat3::identity() * (self.area * dm),
+                self.area * w,
+            );
         }
         let qh = q / kappa;
         let ratio = m / kappa;
@@ -195,7 +214,12 @@ mod tests {
 
     #[test]
     fn hinge_gradient_matches_finite_differences() {
-        let h = Hinge { nodes: [0, 1, 2, 3], edge: 1.0, area: 1.0, warp_weight: 1.0 };
+        let h = Hinge {
+            nodes: [0, 1, 2, 3],
+            edge: 1.0,
+            area: 1.0,
+            warp_weight: 1.0,
+        };
         let x = vec![
             Vec3::new(0.0, 0.0, 0.0),
             Vec3::new(1.0, 0.1, 0.0),
@@ -209,8 +233,14 @@ mod tests {
                 let mut xm = x.clone();
                 xp[m][k] += 1e-6;
                 xm[m][k] -= 1e-6;
-                let fd = (h.angle_and_gradient(&xp).unwrap().0 - h.angle_and_gradient(&xm).unwrap().0) / 2e-6;
-                assert!((fd - g[m][k]).abs() < 1e-6, "node {m} axis {k}: fd {fd} vs {}", g[m][k]);
+                let fd = (h.angle_and_gradient(&xp).unwrap().0
+                    - h.angle_and_gradient(&xm).unwrap().0)
+                    / 2e-6;
+                assert!(
+                    (fd - g[m][k]).abs() < 1e-6,
+                    "node {m} axis {k}: fd {fd} vs {}",
+                    g[m][k]
+                );
             }
         }
     }

@@ -50,7 +50,13 @@ impl LineSolver {
     /// Prepares the solver for an `nx` × `ny` grid whose matrix pattern is `a`.
     pub fn new(a: &Bcsr3, nx: usize, ny: usize) -> Self {
         let n = nx * ny;
-        let slot = |k: usize, back: usize, ok: bool| if ok { a.slot(k, k - back).unwrap_or(NONE) } else { NONE };
+        let slot = |k: usize, back: usize, ok: bool| {
+            if ok {
+                a.slot(k, k - back).unwrap_or(NONE)
+            } else {
+                NONE
+            }
+        };
         let factors = |stride: usize, pos: &dyn Fn(usize) -> usize| {
             let z = vec![Mat3f::zeros(); n];
             Factors {
@@ -65,7 +71,13 @@ impl LineSolver {
         };
         let warp = factors(1, &|k| k % nx);
         let weft = factors(nx, &|k| k / nx);
-        LineSolver { nx, ny, warp, weft, y: vec![Vec3::zeros(); n] }
+        LineSolver {
+            nx,
+            ny,
+            warp,
+            weft,
+            y: vec![Vec3::zeros(); n],
+        }
     }
 
     #[inline]
@@ -118,9 +130,21 @@ impl LineSolver {
                 let (mut g_2, mut u1_2, mut u2_2) = (Mat3::zeros(), Mat3::zeros(), Mat3::zeros());
                 for t in 0..len {
                     let k = first + t * s;
-                    let a2 = if t >= 2 { blk(k, 2 * s, prev2[k]) } else { Mat3::zeros() };
-                    let mut a1 = if t >= 1 { blk(k, s, prev1[k]) } else { Mat3::zeros() };
-                    let mut d = if fixed[k] { Mat3::identity() } else { a.values[a.diag[k]] };
+                    let a2 = if t >= 2 {
+                        blk(k, 2 * s, prev2[k])
+                    } else {
+                        Mat3::zeros()
+                    };
+                    let mut a1 = if t >= 1 {
+                        blk(k, s, prev1[k])
+                    } else {
+                        Mat3::zeros()
+                    };
+                    let mut d = if fixed[k] {
+                        Mat3::identity()
+                    } else {
+                        a.values[a.diag[k]]
+                    };
                     // eliminate column k − 2s, then column k − s
                     let l2 = if t >= 2 { a2 * g_2 } else { Mat3::zeros() };
                     if t >= 2 {
@@ -134,8 +158,16 @@ impl LineSolver {
                     let g = d.try_inverse().unwrap_or_else(Mat3::identity);
                     // upper blocks (k, k + s), (k, k + 2s): transposes of later rows' lower blocks
                     // (A is symmetric), minus the fill from column k − s
-                    let mut u1 = if t + 1 < len { blk(k + s, s, prev1[k + s]).transpose() } else { Mat3::zeros() };
-                    let u2 = if t + 2 < len { blk(k + 2 * s, 2 * s, prev2[k + 2 * s]).transpose() } else { Mat3::zeros() };
+                    let mut u1 = if t + 1 < len {
+                        blk(k + s, s, prev1[k + s]).transpose()
+                    } else {
+                        Mat3::zeros()
+                    };
+                    let u2 = if t + 2 < len {
+                        blk(k + 2 * s, 2 * s, prev2[k + 2 * s]).transpose()
+                    } else {
+                        Mat3::zeros()
+                    };
                     if t >= 1 && t + 1 < len {
                         u1 -= l1 * u2_1;
                     }
@@ -157,7 +189,15 @@ impl LineSolver {
     /// One block Gauss–Seidel sweep over all lines of `dir`: for each of three colours in
     /// `order`, the residual `r − A e` of that colour's lines is solved exactly on each line
     /// and added to `e`. Fixed particles keep a zero correction.
-    pub fn sweep(&mut self, a: &Bcsr3, dir: LineDir, r: &[Vec3], e: &mut [Vec3], fixed: &[bool], order: [usize; 3]) {
+    pub fn sweep(
+        &mut self,
+        a: &Bcsr3,
+        dir: LineDir,
+        r: &[Vec3],
+        e: &mut [Vec3],
+        fixed: &[bool],
+        order: [usize; 3],
+    ) {
         let (nx, ny) = (self.nx, self.ny);
         let nl = self.line_count(dir);
         let f = match dir {
@@ -177,7 +217,11 @@ impl LineSolver {
                     // residual of the line, then forward elimination in place
                     for t in 0..len {
                         let k = first + t * s;
-                        let mut d = if fixed[k] { Vec3::zeros() } else { r[k] - a.row_times32_ptr(k, ep.0) };
+                        let mut d = if fixed[k] {
+                            Vec3::zeros()
+                        } else {
+                            r[k] - a.row_times32_ptr(k, ep.0)
+                        };
                         if t >= 1 {
                             d -= f.l1[k].cast::<f64>() * *yp.at(k - s);
                         }
@@ -189,7 +233,8 @@ impl LineSolver {
                     let (mut x1, mut x2) = (Vec3::zeros(), Vec3::zeros());
                     for t in (0..len).rev() {
                         let k = first + t * s;
-                        let xk = f.g[k].cast::<f64>() * (*yp.at(k) - f.u1[k].cast::<f64>() * x1 - f.u2[k].cast::<f64>() * x2);
+                        let xk = f.g[k].cast::<f64>()
+                            * (*yp.at(k) - f.u1[k].cast::<f64>() * x1 - f.u2[k].cast::<f64>() * x2);
                         *ep.at(k) += xk;
                         x2 = x1;
                         x1 = xk;

@@ -49,7 +49,11 @@ impl MaterialLaw for LinearMaterial {
         (k * strain, k, 0.5 * k * strain * strain)
     }
     fn shear(&self, gamma: f64) -> (f64, f64, f64) {
-        (self.shear * gamma, self.shear, 0.5 * self.shear * gamma * gamma)
+        (
+            self.shear * gamma,
+            self.shear,
+            0.5 * self.shear * gamma * gamma,
+        )
     }
     fn bending(&self, dir: Direction, kappa: f64) -> (f64, f64, f64) {
         let b = match dir {
@@ -117,11 +121,16 @@ impl FabricParameters {
         ];
         for (name, v) in fields {
             if !v.is_finite() || v < 0.0 {
-                return Err(format!("fabric parameter `{name}` must be finite and ≥ 0, got {v}"));
+                return Err(format!(
+                    "fabric parameter `{name}` must be finite and ≥ 0, got {v}"
+                ));
             }
         }
         if self.density <= 0.0 {
-            return Err(format!("fabric parameter `density` must be > 0, got {}", self.density));
+            return Err(format!(
+                "fabric parameter `density` must be > 0, got {}",
+                self.density
+            ));
         }
         Ok(())
     }

@@ -58,21 +58,57 @@ impl ClothModel {
         for i in 0..ny {
             for j in 0..nx {
                 if j + 1 < nx {
-                    springs.push(Spring { a: id(i, j), b: id(i, j + 1), rest: dx, area: wy(i) * dx, kind: warp });
+                    springs.push(Spring {
+                        a: id(i, j),
+                        b: id(i, j + 1),
+                        rest: dx,
+                        area: wy(i) * dx,
+                        kind: warp,
+                    });
                 }
                 if i + 1 < ny {
-                    springs.push(Spring { a: id(i, j), b: id(i + 1, j), rest: dy, area: wx(j) * dy, kind: weft });
+                    springs.push(Spring {
+                        a: id(i, j),
+                        b: id(i + 1, j),
+                        rest: dy,
+                        area: wx(j) * dy,
+                        kind: weft,
+                    });
                 }
                 if i + 1 < ny && j + 1 < nx {
                     let area = 0.25 * diag * diag;
-                    springs.push(Spring { a: id(i, j), b: id(i + 1, j + 1), rest: diag, area, kind: SpringKind::Shear });
-                    springs.push(Spring { a: id(i, j + 1), b: id(i + 1, j), rest: diag, area, kind: SpringKind::Shear });
+                    springs.push(Spring {
+                        a: id(i, j),
+                        b: id(i + 1, j + 1),
+                        rest: diag,
+                        area,
+                        kind: SpringKind::Shear,
+                    });
+                    springs.push(Spring {
+                        a: id(i, j + 1),
+                        b: id(i + 1, j),
+                        rest: diag,
+                        area,
+                        kind: SpringKind::Shear,
+                    });
                 }
                 if j >= 1 && j + 1 < nx {
-                    bend_lines.push(BendLine::new([id(i, j - 1), id(i, j), id(i, j + 1)], dx, dx, wy(i), Direction::Warp));
+                    bend_lines.push(BendLine::new(
+                        [id(i, j - 1), id(i, j), id(i, j + 1)],
+                        dx,
+                        dx,
+                        wy(i),
+                        Direction::Warp,
+                    ));
                 }
                 if i >= 1 && i + 1 < ny {
-                    bend_lines.push(BendLine::new([id(i - 1, j), id(i, j), id(i + 1, j)], dy, dy, wx(j), Direction::Weft));
+                    bend_lines.push(BendLine::new(
+                        [id(i - 1, j), id(i, j), id(i + 1, j)],
+                        dy,
+                        dy,
+                        wx(j),
+                        Direction::Weft,
+                    ));
                 }
             }
         }
@@ -101,7 +137,9 @@ impl ClothModel {
         let topo = Topology::of(&mesh);
         let n = mesh.vertex_count();
         // summed area of triangles incident to each edge
-        let tri_area: Vec<f64> = (0..mesh.triangles.len()).map(|t| mesh.rest_area(t)).collect();
+        let tri_area: Vec<f64> = (0..mesh.triangles.len())
+            .map(|t| mesh.rest_area(t))
+            .collect();
         let mut edge_area = std::collections::BTreeMap::new();
         for (t, tri) in mesh.triangles.iter().enumerate() {
             for k in 0..3 {
@@ -119,11 +157,22 @@ impl ClothModel {
             let l2 = du * du + dv * dv;
             let rest = l2.sqrt();
             if rest <= 0.0 {
-                return Err(ClothError::Parameter(format!("edge {}–{} has zero rest length", e.a, e.b)));
+                return Err(ClothError::Parameter(format!(
+                    "edge {}–{} has zero rest length",
+                    e.a, e.b
+                )));
             }
             // k = E · ΣA / L0²: exact for axis-aligned edges of a right-triangle grid
             let area = edge_area[&(e.a, e.b)];
-            springs.push(Spring { a: e.a, b: e.b, rest, area, kind: SpringKind::Stretch { warp_weight: du * du / l2 } });
+            springs.push(Spring {
+                a: e.a,
+                b: e.b,
+                rest,
+                area,
+                kind: SpringKind::Stretch {
+                    warp_weight: du * du / l2,
+                },
+            });
         }
         let mut hinges = Vec::with_capacity(topo.hinges.len());
         for h in &topo.hinges {
@@ -131,12 +180,23 @@ impl ClothModel {
             let (cu, cv) = rest_vec(h.c, h.d);
             let cross = (cu * cu + cv * cv).sqrt();
             if cross > 0.0 {
-                springs.push(Spring { a: h.c, b: h.d, rest: cross, area: 2.0 * a0 / 3.0, kind: SpringKind::Shear });
+                springs.push(Spring {
+                    a: h.c,
+                    b: h.d,
+                    rest: cross,
+                    area: 2.0 * a0 / 3.0,
+                    kind: SpringKind::Shear,
+                });
             }
             let (du, dv) = rest_vec(h.a, h.b);
             let l2 = du * du + dv * dv;
             // curvature direction is perpendicular to the edge: its warp share is dv²/l²
-            hinges.push(Hinge { nodes: [h.a, h.b, h.c, h.d], edge: l2.sqrt(), area: a0, warp_weight: dv * dv / l2 });
+            hinges.push(Hinge {
+                nodes: [h.a, h.b, h.c, h.d],
+                edge: l2.sqrt(),
+                area: a0,
+                warp_weight: dv * dv / l2,
+            });
         }
         let area = mesh.vertex_rest_areas();
         let mass = area.iter().map(|a| a * fabric.density).collect();

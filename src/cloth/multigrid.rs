@@ -17,7 +17,12 @@ use crate::geometry::Vec3;
 
 /// Coarsest grid size (particles per side) at which the V-cycle stops coarsening.
 const COARSEST: usize = 6;
-fn coarsest() -> usize { std::env::var("MG_COARSEST").ok().and_then(|s| s.parse().ok()).unwrap_or(COARSEST) }
+fn coarsest() -> usize {
+    std::env::var("MG_COARSEST")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(COARSEST)
+}
 /// Smoothing sweeps on the coarsest level.
 const COARSE_SWEEPS: usize = 3;
 
@@ -162,7 +167,9 @@ impl Multigrid {
     /// Builds the hierarchy for `model`, which must be a grid cloth with matrix pattern `a`.
     pub fn new(model: &ClothModel, a: &Bcsr3) -> Result<Self, ClothError> {
         let Some((nx, ny)) = model.grid else {
-            return Err(ClothError::Parameter("the multigrid preconditioner needs a grid cloth".into()));
+            return Err(ClothError::Parameter(
+                "the multigrid preconditioner needs a grid cloth".into(),
+            ));
         };
         let (w, h) = grid_extent(model, nx, ny);
         let n = nx * ny;
@@ -207,7 +214,10 @@ impl Multigrid {
             });
             (fx, fy) = (cx, cy);
         }
-        Ok(Multigrid { levels, timing: (0.0, 0.0, 0) })
+        Ok(Multigrid {
+            levels,
+            timing: (0.0, 0.0, 0),
+        })
     }
 
     /// Number of levels including the finest.
@@ -217,7 +227,14 @@ impl Multigrid {
 
     /// Rebuilds every level's operator for the current step: coarse states sampled from the
     /// fine one, coarse matrices assembled, fixed particles mapped, lines factorised.
-    pub fn setup(&mut self, a: &Bcsr3, x: &[Vec3], v: &[Vec3], fixed: &[bool], inp: AssemblyInputs) {
+    pub fn setup(
+        &mut self,
+        a: &Bcsr3,
+        x: &[Vec3],
+        v: &[Vec3],
+        fixed: &[bool],
+        inp: AssemblyInputs,
+    ) {
         let t0 = std::time::Instant::now();
         self.levels[0].fixed.copy_from_slice(fixed);
         self.levels[0].lines.factor(a, fixed);
@@ -263,8 +280,10 @@ impl Multigrid {
             lv.e.fill(Vec3::zeros());
             // pre-smoothing: warp lines, then weft lines, colours forward
             for _ in 0..passes {
-                lv.lines.sweep(a, LineDir::Warp, &lv.r, &mut lv.e, &lv.fixed, FORWARD);
-                lv.lines.sweep(a, LineDir::Weft, &lv.r, &mut lv.e, &lv.fixed, FORWARD);
+                lv.lines
+                    .sweep(a, LineDir::Warp, &lv.r, &mut lv.e, &lv.fixed, FORWARD);
+                lv.lines
+                    .sweep(a, LineDir::Weft, &lv.r, &mut lv.e, &lv.fixed, FORWARD);
             }
             if !last {
                 residual(a, &lv.r, &lv.e, &mut lv.d, &lv.fixed);
@@ -274,12 +293,18 @@ impl Multigrid {
             {
                 let (fine, coarse) = self.levels.split_at_mut(l + 1);
                 let (f, c) = (&fine[l], &mut coarse[0]);
-                f.to_fine.as_ref().expect("transfer").restrict(&f.d, &mut c.r, &c.fixed);
+                f.to_fine
+                    .as_ref()
+                    .expect("transfer")
+                    .restrict(&f.d, &mut c.r, &c.fixed);
             }
             self.vcycle(l + 1, a0);
             let (fine, coarse) = self.levels.split_at_mut(l + 1);
             let (f, c) = (&mut fine[l], &coarse[0]);
-            f.to_fine.as_ref().expect("transfer").prolong_add(&c.e, &mut f.e, &f.fixed);
+            f.to_fine
+                .as_ref()
+                .expect("transfer")
+                .prolong_add(&c.e, &mut f.e, &f.fixed);
         }
         let lv = &mut self.levels[l];
         let a = match &lv.asm {
@@ -288,8 +313,10 @@ impl Multigrid {
         };
         // post-smoothing, the adjoint of the pre-smoothing: weft then warp, colours backward
         for _ in 0..passes {
-            lv.lines.sweep(a, LineDir::Weft, &lv.r, &mut lv.e, &lv.fixed, BACKWARD);
-            lv.lines.sweep(a, LineDir::Warp, &lv.r, &mut lv.e, &lv.fixed, BACKWARD);
+            lv.lines
+                .sweep(a, LineDir::Weft, &lv.r, &mut lv.e, &lv.fixed, BACKWARD);
+            lv.lines
+                .sweep(a, LineDir::Warp, &lv.r, &mut lv.e, &lv.fixed, BACKWARD);
         }
     }
 }
@@ -306,7 +333,11 @@ fn residual(a: &Bcsr3, r: &[Vec3], e: &[Vec3], d: &mut [Vec3], fixed: &[bool]) {
             // SAFETY: each index is written by one task only.
             let out = unsafe { &mut *dp.at(i) };
             // SAFETY: e is only read here.
-            *out = if fixed[i] { Vec3::zeros() } else { r[i] - unsafe { a.row_times32_ptr(i, e.as_ptr()) } };
+            *out = if fixed[i] {
+                Vec3::zeros()
+            } else {
+                r[i] - unsafe { a.row_times32_ptr(i, e.as_ptr()) }
+            };
         }
     });
 }

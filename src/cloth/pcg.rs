@@ -38,7 +38,15 @@ impl PcgWorkspace {
     pub fn new(n: usize) -> Self {
         let z = vec![Vec3::zeros(); n];
         let nc = chunks(n.max(1), CHUNK);
-        PcgWorkspace { r: z.clone(), c: z.clone(), q: z.clone(), s: z.clone(), s_old: z, p1: vec![0.0; nc], p2: vec![0.0; nc] }
+        PcgWorkspace {
+            r: z.clone(),
+            c: z.clone(),
+            q: z.clone(),
+            s: z.clone(),
+            s_old: z,
+            p1: vec![0.0; nc],
+            p2: vec![0.0; nc],
+        }
     }
 
     /// Solves for `dv`. On entry `dv` holds the initial guess for the free directions (e.g. the
@@ -58,7 +66,13 @@ impl PcgWorkspace {
     ) -> PcgResult {
         let n = b.len();
         let nc = chunks(n, CHUNK);
-        let (r, c, q, s, s_old) = (&mut self.r, &mut self.c, &mut self.q, &mut self.s, &mut self.s_old);
+        let (r, c, q, s, s_old) = (
+            &mut self.r,
+            &mut self.c,
+            &mut self.q,
+            &mut self.s,
+            &mut self.s_old,
+        );
         let (p1, p2) = (&mut self.p1[..nc], &mut self.p2[..nc]);
         // Δv = S Δv0 + z
         dv.par_chunks_mut(CHUNK).enumerate().for_each(|(ci, d)| {
@@ -68,10 +82,16 @@ impl PcgWorkspace {
             }
         });
         // denominator: ‖S(b − A z)‖²; q = A z as scratch
+        // z is non-zero only at constrained particles: A z = Σ_i A_{·i} z_i = Σ_i A_{i·}ᵀ z_i
+        q.fill(Vec3::zeros());
         if filter.any {
-            a.mul_vec(z, q);
-        } else {
-            q.fill(Vec3::zeros());
+            for (i, zi) in z.iter().enumerate() {
+                if *zi != Vec3::zeros() {
+                    for k in a.row_ptr[i]..a.row_ptr[i + 1] {
+                        q[a.cols[k] as usize] += a.values[k].transpose() * zi;
+                    }
+                }
+            }
         }
         p1.par_iter_mut().enumerate().for_each(|(ci, p)| {
             let mut acc = 0.0;
@@ -83,16 +103,19 @@ impl PcgWorkspace {
         let bnorm2 = ordered_sum(p1);
         // r = S(b − A Δv), ρ = r·r
         let dvr: &[Vec3] = dv;
-        r.par_chunks_mut(CHUNK).zip(p2.par_iter_mut()).enumerate().for_each(|(ci, (rs, pr))| {
-            let mut rr = 0.0;
-            for k in 0..rs.len() {
-                let i = ci * CHUNK + k;
-                let ri = filter.apply(i, b[i] - a.row_times(i, dvr));
-                rr += ri.norm_squared();
-                rs[k] = ri;
-            }
-            *pr = rr;
-        });
+        r.par_chunks_mut(CHUNK)
+            .zip(p2.par_iter_mut())
+            .enumerate()
+            .for_each(|(ci, (rs, pr))| {
+                let mut rr = 0.0;
+                for k in 0..rs.len() {
+                    let i = ci * CHUNK + k;
+                    let ri = filter.apply(i, b[i] - a.row_times(i, dvr));
+                    rr += ri.norm_squared();
+                    rs[k] = ri;
+                }
+                *pr = rr;
+            });
         let mut rr = ordered_sum(p2);
         let target = tolerance * tolerance * bnorm2;
         let mut it = 0;
@@ -103,16 +126,19 @@ impl PcgWorkspace {
             while rr > target && it < max_iterations && delta > 0.0 {
                 // q = S A c, cq = c·q
                 let cr: &[Vec3] = c;
-                q.par_chunks_mut(CHUNK).zip(p1.par_iter_mut()).enumerate().for_each(|(ci, (qs, p))| {
-                    let mut acc = 0.0;
-                    for k in 0..qs.len() {
-                        let i = ci * CHUNK + k;
-                        let qi = filter.apply(i, a.row_times(i, cr));
-                        acc += cr[i].dot(&qi);
-                        qs[k] = qi;
-                    }
-                    *p = acc;
-                });
+                q.par_chunks_mut(CHUNK)
+                    .zip(p1.par_iter_mut())
+                    .enumerate()
+                    .for_each(|(ci, (qs, p))| {
+                        let mut acc = 0.0;
+                        for k in 0..qs.len() {
+                            let i = ci * CHUNK + k;
+                            let qi = filter.apply(i, a.row_times(i, cr));
+                            acc += cr[i].dot(&qi);
+                            qs[k] = qi;
+                        }
+                        *p = acc;
+                    });
                 let cq = ordered_sum(p1);
                 if cq <= 0.0 {
                     break;
@@ -146,8 +172,16 @@ impl PcgWorkspace {
                 delta = dnew;
             }
         }
-        let residual = if bnorm2 > 0.0 { (rr / bnorm2).sqrt() } else { 0.0 };
-        PcgResult { iterations: it, residual, converged: rr <= target }
+        let residual = if bnorm2 > 0.0 {
+            (rr / bnorm2).sqrt()
+        } else {
+            0.0
+        };
+        PcgResult {
+            iterations: it,
+            residual,
+            converged: rr <= target,
+        }
     }
 }
 
@@ -192,19 +226,26 @@ fn dots(
     update: bool,
 ) -> (f64, f64) {
     let n = r.len();
-    p1.par_iter_mut().zip(p2.par_iter_mut()).enumerate().for_each(|(ci, (a, b))| {
-        let (mut x, mut y) = (0.0, 0.0);
-        for i in ci * CHUNK..((ci + 1) * CHUNK).min(n) {
-            x += r[i].dot(&s[i]);
-            if update {
-                y += r[i].dot(&s_old[i]);
+    p1.par_iter_mut()
+        .zip(p2.par_iter_mut())
+        .enumerate()
+        .for_each(|(ci, (a, b))| {
+            let (mut x, mut y) = (0.0, 0.0);
+            for i in ci * CHUNK..((ci + 1) * CHUNK).min(n) {
+                x += r[i].dot(&s[i]);
+                if update {
+                    y += r[i].dot(&s_old[i]);
+                }
             }
-        }
-        *a = x;
-        *b = y;
-    });
+            *a = x;
+            *b = y;
+        });
     let dnew = ordered_sum(p1);
-    let beta = if update { ((dnew - ordered_sum(p2)) / delta_old).max(0.0) } else { 0.0 };
+    let beta = if update {
+        ((dnew - ordered_sum(p2)) / delta_old).max(0.0)
+    } else {
+        0.0
+    };
     c.par_chunks_mut(CHUNK).enumerate().for_each(|(ci, cs)| {
         for k in 0..cs.len() {
             let i = ci * CHUNK + k;

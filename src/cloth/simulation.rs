@@ -81,7 +81,9 @@ impl Default for SimulationParameters {
 impl SimulationParameters {
     /// Checks the values, naming the first bad parameter.
     pub fn validate(&self) -> Result<(), ClothError> {
-        let bad = |name: &str, v: f64| ClothError::Parameter(format!("simulation parameter `{name}` is invalid: {v}"));
+        let bad = |name: &str, v: f64| {
+            ClothError::Parameter(format!("simulation parameter `{name}` is invalid: {v}"))
+        };
         if !(self.dt.is_finite() && self.dt > 0.0) {
             return Err(bad("dt", self.dt));
         }
@@ -139,7 +141,9 @@ impl Simulation {
         let state = ClothState::at_rest(model.mesh.positions.clone());
         let mg = match (params.preconditioner, model.grid) {
             (PreconditionerKind::BlockJacobi, _) => None,
-            (PreconditionerKind::Auto, Some((nx, ny))) if nx.min(ny) >= 16 => Some(Multigrid::new(&model, &asm.a)?),
+            (PreconditionerKind::Auto, Some((nx, ny))) if nx.min(ny) >= 16 => {
+                Some(Multigrid::new(&model, &asm.a)?)
+            }
             (PreconditionerKind::Auto, _) => None,
             (PreconditionerKind::Multigrid, _) => Some(Multigrid::new(&model, &asm.a)?),
         };
@@ -184,7 +188,9 @@ impl Simulation {
     fn check_particles(&self, particles: &[usize]) -> Result<(), ClothError> {
         let n = self.particle_count();
         match particles.iter().find(|&&i| i >= n) {
-            Some(i) => Err(ClothError::Parameter(format!("particle index {i} out of range (cloth has {n})"))),
+            Some(i) => Err(ClothError::Parameter(format!(
+                "particle index {i} out of range (cloth has {n})"
+            ))),
             None => Ok(()),
         }
     }
@@ -196,20 +202,35 @@ impl Simulation {
 
     /// Attaches `particles` to a target moving along `trajectory` from their current positions,
     /// with the trajectory's clock starting now. Returns the attachment index.
-    pub fn attach(&mut self, particles: &[usize], trajectory: Trajectory) -> Result<usize, ClothError> {
+    pub fn attach(
+        &mut self,
+        particles: &[usize],
+        trajectory: Trajectory,
+    ) -> Result<usize, ClothError> {
         self.check_particles(particles)?;
         trajectory.validate().map_err(ClothError::Parameter)?;
         let t0 = self.state.time;
         let shift = trajectory.displacement(t0);
-        let anchors = particles.iter().map(|&i| (self.state.x[i] - shift).into()).collect();
-        self.attachments.push(Attachment { particles: particles.to_vec(), anchors, trajectory });
+        let anchors = particles
+            .iter()
+            .map(|&i| (self.state.x[i] - shift).into())
+            .collect();
+        self.attachments.push(Attachment {
+            particles: particles.to_vec(),
+            anchors,
+            trajectory,
+        });
         Ok(self.attachments.len() - 1)
     }
 
     /// Removes every attachment of `particles` (they become free).
     pub fn release(&mut self, particles: &[usize]) {
         for at in &mut self.attachments {
-            let keep: Vec<bool> = at.particles.iter().map(|i| !particles.contains(i)).collect();
+            let keep: Vec<bool> = at
+                .particles
+                .iter()
+                .map(|i| !particles.contains(i))
+                .collect();
             let mut k = keep.iter();
             at.particles.retain(|_| *k.next().unwrap());
             let mut k = keep.iter();
@@ -237,8 +258,14 @@ impl Simulation {
 
     /// Energies of the current state: (kinetic, gravitational, elastic).
     pub fn energy(&mut self) -> (f64, f64, f64) {
-        let inp = AssemblyInputs { dt: self.params.dt, gravity: Vec3::from(self.params.gravity), matrix: false };
-        let elastic = self.asm.assemble(&self.model, &self.state.x, &self.state.v, inp);
+        let inp = AssemblyInputs {
+            dt: self.params.dt,
+            gravity: Vec3::from(self.params.gravity),
+            matrix: false,
+        };
+        let elastic = self
+            .asm
+            .assemble(&self.model, &self.state.x, &self.state.v, inp);
         let (k, g) = self.kinetic_gravity();
         (k, g, elastic)
     }
@@ -257,12 +284,20 @@ impl Simulation {
     fn build_filter(&mut self, t_end: f64, dt: f64) {
         self.filter.clear();
         for hook in &mut self.hooks {
-            hook.constrain(&self.state.x, &self.state.v, self.state.time, dt, &mut self.filter);
+            hook.constrain(
+                &self.state.x,
+                &self.state.v,
+                self.state.time,
+                dt,
+                &mut self.filter,
+            );
         }
         for at in &self.attachments {
             let d = at.trajectory.displacement(t_end);
             for (k, &i) in at.particles.iter().enumerate() {
-                self.filter.kind[i] = ParticleFilter::Fixed { target: Vec3::from(at.anchors[k]) + d };
+                self.filter.kind[i] = ParticleFilter::Fixed {
+                    target: Vec3::from(at.anchors[k]) + d,
+                };
                 self.filter.any = true;
             }
         }
@@ -284,7 +319,11 @@ impl Simulation {
             Integrator::Explicit => self.step_explicit(),
         };
         if let Err(cause) = self.check_state() {
-            let err = ClothError::Diverged { step: self.state.step, time: self.state.time, cause };
+            let err = ClothError::Diverged {
+                step: self.state.step,
+                time: self.state.time,
+                cause,
+            };
             self.state.x.copy_from_slice(&self.x_save);
             self.state.v.copy_from_slice(&self.v_save);
             return Err(err);
@@ -306,7 +345,9 @@ impl Simulation {
         for i in 0..self.particle_count() {
             let (x, v) = (&self.state.x[i], &self.state.v[i]);
             if !(x.iter().all(|c| c.is_finite()) && v.iter().all(|c| c.is_finite())) {
-                return Err(format!("particle {i} got a non-finite position or velocity (NaN)"));
+                return Err(format!(
+                    "particle {i} got a non-finite position or velocity (NaN)"
+                ));
             }
             if v.norm_squared() > vmax2 {
                 return Err(format!(
@@ -325,8 +366,14 @@ impl Simulation {
         self.build_filter(t_end, h);
         let (kinetic, gravity) = self.kinetic_gravity();
         let t0 = Instant::now();
-        let inp = AssemblyInputs { dt: h, gravity: Vec3::from(self.params.gravity), matrix: true };
-        let elastic = self.asm.assemble(&self.model, &self.state.x, &self.state.v, inp);
+        let inp = AssemblyInputs {
+            dt: h,
+            gravity: Vec3::from(self.params.gravity),
+            matrix: true,
+        };
+        let elastic = self
+            .asm
+            .assemble(&self.model, &self.state.x, &self.state.v, inp);
         let t1 = Instant::now();
         for i in 0..self.particle_count() {
             self.z[i] = self.filter.z(i, &self.state.x[i], &self.state.v[i], h);
@@ -396,8 +443,14 @@ impl Simulation {
         for k in 0..sub {
             let t_end = self.state.time + h * (k + 1) as f64;
             self.build_filter(t_end, h);
-            let inp = AssemblyInputs { dt: h, gravity, matrix: false };
-            let e = self.asm.assemble(&self.model, &self.state.x, &self.state.v, inp);
+            let inp = AssemblyInputs {
+                dt: h,
+                gravity,
+                matrix: false,
+            };
+            let e = self
+                .asm
+                .assemble(&self.model, &self.state.x, &self.state.v, inp);
             if k == 0 {
                 elastic0 = e;
             }
@@ -405,7 +458,8 @@ impl Simulation {
                 let vn = self.state.v[i] + self.asm.b[i] * (h / self.model.mass[i]);
                 // constrained directions take the prescribed velocity
                 let z = self.filter.z(i, &self.state.x[i], &self.state.v[i], h);
-                self.state.v[i] = self.filter.apply(i, vn) + (self.state.v[i] + z - self.filter.apply(i, self.state.v[i] + z));
+                self.state.v[i] = self.filter.apply(i, vn)
+                    + (self.state.v[i] + z - self.filter.apply(i, self.state.v[i] + z));
                 self.state.x[i] += self.state.v[i] * h;
             }
             self.finish_constraints();

@@ -21,6 +21,11 @@ impl ClothState {
     /// A state at rest at positions `x`, time 0.
     pub fn at_rest(x: Vec<Vec3>) -> Self {
         let n = x.len();
-        ClothState { x, v: vec![Vec3::zeros(); n], time: 0.0, step: 0 }
+        ClothState {
+            x,
+            v: vec![Vec3::zeros(); n],
+            time: 0.0,
+            step: 0,
+        }
     }
 }

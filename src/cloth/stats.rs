@@ -39,7 +39,10 @@ pub struct StepStats {
 const HEADER: &str = "step,time,kinetic,gravity,elastic,total,cg_iterations,residual,converged,assemble_ms,solve_ms,step_ms";
 
 fn write_atomic(path: &Path, body: &[u8]) -> Result<(), ClothError> {
-    let err = |e: std::io::Error| ClothError::Output { path: path.display().to_string(), message: e.to_string() };
+    let err = |e: std::io::Error| ClothError::Output {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    };
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(err)?;
     }
@@ -58,8 +61,18 @@ pub fn write_csv(path: &Path, stats: &[StepStats]) -> Result<(), ClothError> {
     for r in stats {
         s.push_str(&format!(
             "{},{},{},{},{},{},{},{},{},{},{},{}\n",
-            r.step, r.time, r.kinetic, r.gravity, r.elastic, r.total, r.cg_iterations, r.residual,
-            r.converged as u8, r.assemble_ms, r.solve_ms, r.step_ms
+            r.step,
+            r.time,
+            r.kinetic,
+            r.gravity,
+            r.elastic,
+            r.total,
+            r.cg_iterations,
+            r.residual,
+            r.converged as u8,
+            r.assemble_ms,
+            r.solve_ms,
+            r.step_ms
         ));
     }
     write_atomic(path, s.as_bytes())
@@ -67,7 +80,9 @@ pub fn write_csv(path: &Path, stats: &[StepStats]) -> Result<(), ClothError> {
 
 /// Writes statistics as a JSON array.
 pub fn write_json(path: &Path, stats: &[StepStats]) -> Result<(), ClothError> {
-    let body = serde_json::to_vec_pretty(stats)
-        .map_err(|e| ClothError::Output { path: path.display().to_string(), message: e.to_string() })?;
+    let body = serde_json::to_vec_pretty(stats).map_err(|e| ClothError::Output {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })?;
     write_atomic(path, &body)
 }

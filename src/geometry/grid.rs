@@ -41,5 +41,9 @@ pub fn grid_mesh(width: f64, height: f64, nx: usize, ny: usize) -> Result<TriMes
             }
         }
     }
-    Ok(TriMesh { positions, rest, triangles })
+    Ok(TriMesh {
+        positions,
+        rest,
+        triangles,
+    })
 }

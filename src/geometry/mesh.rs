@@ -31,11 +31,23 @@ impl TriMesh {
                 self.rest.len()
             )));
         }
-        if let Some(i) = self.positions.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
-            return Err(GeometryError::Invalid(format!("vertex {i} has a non-finite position")));
+        if let Some(i) = self
+            .positions
+            .iter()
+            .position(|p| !p.iter().all(|c| c.is_finite()))
+        {
+            return Err(GeometryError::Invalid(format!(
+                "vertex {i} has a non-finite position"
+            )));
         }
-        if let Some(i) = self.rest.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
-            return Err(GeometryError::Invalid(format!("vertex {i} has a non-finite rest coordinate")));
+        if let Some(i) = self
+            .rest
+            .iter()
+            .position(|p| !p.iter().all(|c| c.is_finite()))
+        {
+            return Err(GeometryError::Invalid(format!(
+                "vertex {i} has a non-finite rest coordinate"
+            )));
         }
         for (t, tri) in self.triangles.iter().enumerate() {
             if tri.iter().any(|&i| i >= n) {

@@ -2,6 +2,7 @@
 //! adjacency, and mesh file I/O (OBJ read/write, binary glTF write).
 
 pub mod error;
+pub(crate) mod files;
 pub mod gltf;
 pub mod grid;
 pub mod mesh;
@@ -9,8 +10,10 @@ pub mod obj;
 pub mod topology;
 
 pub use error::GeometryError;
+pub use gltf::write_glb;
 pub use grid::grid_mesh;
 pub use mesh::TriMesh;
+pub use obj::{read_obj, write_obj};
 pub use topology::{Edge, Hinge, Topology};
 
 /// Three-vector of f64, SI units (metres, m/s, newtons).

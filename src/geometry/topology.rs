@@ -38,7 +38,8 @@ impl Topology {
     /// Builds edges and hinges of `mesh`. Edges with more than two triangles get no hinge.
     pub fn of(mesh: &TriMesh) -> Self {
         // (min, max, triangle's third vertex, oriented a, oriented b)
-        let mut half: Vec<(usize, usize, usize, usize, usize)> = Vec::with_capacity(mesh.triangles.len() * 3);
+        let mut half: Vec<(usize, usize, usize, usize, usize)> =
+            Vec::with_capacity(mesh.triangles.len() * 3);
         for t in &mesh.triangles {
             for k in 0..3 {
                 let (p, q, r) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
@@ -54,7 +55,10 @@ impl Topology {
             while j < half.len() && half[j].0 == half[i].0 && half[j].1 == half[i].1 {
                 j += 1;
             }
-            edges.push(Edge { a: half[i].0, b: half[i].1 });
+            edges.push(Edge {
+                a: half[i].0,
+                b: half[i].1,
+            });
             if j - i == 2 {
                 let (_, _, c, a, b) = half[i];
                 let d = half[i + 1].2;

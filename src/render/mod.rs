@@ -1,1 +1,10 @@
-//! (being written)
+//! Built-in software rendering, so a user sees a result without another tool: a pinhole
+//! [`Camera`] (with automatic framing of a bounding box) and a z-buffered, smooth-shaded
+//! triangle rasterizer that draws [`RenderMesh`]es into an RGB image or a PNG file.
+
+pub mod camera;
+pub mod raster;
+mod shading;
+
+pub use camera::Camera;
+pub use raster::{render, render_png, RenderMesh};

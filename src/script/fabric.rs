@@ -1,0 +1,185 @@
+//! Script bindings for fabrics and cloth models: the `Fabric` value type (a
+//! [`FabricParameters`] with one property per field, checked on every assignment) and the
+//! `Cloth` handle (a shared, immutable [`ClothModel`]) built from a grid or an OBJ file.
+
+use std::fmt;
+use std::path::Path;
+
+use rhai::{Dynamic, Engine, Map, Shared, INT};
+
+use super::convert::{count, get_field, num, to_map, update_field, update_from_map, RResult};
+use super::{getter, register};
+use crate::cloth::{ClothModel, FabricParameters};
+use crate::geometry::read_obj;
+
+/// A fabric as a script value: small, copied freely.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Fabric(pub FabricParameters);
+
+impl fmt::Display for Fabric {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let p = &self.0;
+        write!(
+            f,
+            "Fabric(density {} kg/m², stretch {}/{} N/m, shear {} N/m, bend {:e}/{:e} N·m, damping {}/{} s, drag {})",
+            p.density, p.stretch_warp, p.stretch_weft, p.shear, p.bend_warp, p.bend_weft,
+            p.stretch_damping, p.bend_damping, p.air_drag
+        )
+    }
+}
+
+/// A cloth model as a script handle: the model is shared, never copied per call.
+#[derive(Debug, Clone)]
+pub struct ClothHandle(pub Shared<ClothModel>);
+
+impl fmt::Display for ClothHandle {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let m = &self.0;
+        match m.grid {
+            Some((nx, ny)) => write!(f, "Cloth(grid {nx}×{ny}, {} particles", m.particle_count())?,
+            None => write!(f, "Cloth(mesh, {} particles", m.particle_count())?,
+        }
+        write!(
+            f,
+            ", {} triangles, {} springs)",
+            m.mesh.triangles.len(),
+            m.springs.len()
+        )
+    }
+}
+
+/// Fabric fields settable from scripts, with their documentation.
+pub const FABRIC_FIELDS: [(&str, &str); 9] = [
+    ("density", "Areal density (kg/m², > 0)."),
+    ("stretch_warp", "Tensile rigidity along the warp (N/m)."),
+    ("stretch_weft", "Tensile rigidity along the weft (N/m)."),
+    ("shear", "Shear rigidity (N/m per radian)."),
+    (
+        "bend_warp",
+        "Bending rigidity for curvature along the warp (N·m).",
+    ),
+    (
+        "bend_weft",
+        "Bending rigidity for curvature along the weft (N·m).",
+    ),
+    (
+        "stretch_damping",
+        "Stiffness-proportional damping of stretch and shear (s).",
+    ),
+    (
+        "bend_damping",
+        "Stiffness-proportional damping of bending (s).",
+    ),
+    ("air_drag", "Linear air drag per unit area (N·s/m³)."),
+];
+
+/// Checks fabric parameters, naming the first bad one.
+fn checked(p: FabricParameters) -> RResult<Fabric> {
+    p.validate().map_err(super::convert::rt_err)?;
+    Ok(Fabric(p))
+}
+
+/// Registers `fabric`, its properties, `cloth_grid`, `cloth_obj` and the `Cloth` properties.
+pub fn register(engine: &mut Engine) {
+    engine.register_type_with_name::<Fabric>("Fabric");
+    engine.register_type_with_name::<ClothHandle>("Cloth");
+
+    register!(engine, "fabric", ["Fabric"],
+        "The default fabric: a cotton-like woven (0.15 kg/m², 1000 N/m stretch, soft shear and bending).\nChange fields with `f.density = 0.2`.",
+        Fabric::default);
+    register!(engine, "fabric", ["params: Map", "Fabric"],
+        "A fabric from a map of fields, e.g. `fabric(#{density: 0.2, stretch_warp: 800.0})`;\nunset fields keep their defaults. Unknown keys, negative or non-finite values are errors\nthat name the parameter.",
+        |m: Map| -> RResult<Fabric> { checked(update_from_map(&FabricParameters::default(), &m, "fabric")?) });
+    register!(
+        engine,
+        "to_map",
+        ["fabric: Fabric", "Map"],
+        "The fabric's fields as a map (SI units).",
+        |f: &mut Fabric| -> Dynamic { to_map(&f.0) }
+    );
+    register!(
+        engine,
+        "to_string",
+        ["fabric: Fabric", "String"],
+        "One-line summary of a fabric.",
+        |f: &mut Fabric| f.to_string()
+    );
+    register!(
+        engine,
+        "to_debug",
+        ["fabric: Fabric", "String"],
+        "One-line summary of a fabric.",
+        |f: &mut Fabric| f.to_string()
+    );
+    for (name, doc) in FABRIC_FIELDS {
+        getter!(
+            engine,
+            name,
+            ["fabric: Fabric", "float"],
+            doc,
+            move |f: &mut Fabric| -> RResult<Dynamic> { get_field(&f.0, name, "fabric") }
+        );
+        rhai::FuncRegistration::new_setter(name)
+            .with_params_info(["fabric: Fabric", "value: float"])
+            .with_comments([super::convert::doc_comment(&format!(
+                "{doc}\nChecked on assignment: must be finite and ≥ 0."
+            ))])
+            .register_into_engine(engine, move |f: &mut Fabric, v: Dynamic| -> RResult<()> {
+                *f = checked(update_field(&f.0, name, &v, "fabric")?)?;
+                Ok(())
+            });
+    }
+
+    register!(engine, "cloth_grid", ["width: float", "height: float", "nx: int", "ny: int", "fabric: Fabric", "Cloth"],
+        "A `width` × `height` m rectangle of `nx` × `ny` particles, flat in the XY plane at z = 0,\ncentred at the origin. Particle (row i along y, column j along x) has index `i * nx + j`;\nthe y = +height/2 edge is \"top\".",
+        |w: Dynamic, h: Dynamic, nx: INT, ny: INT, f: Fabric| -> RResult<ClothHandle> {
+            let (w, h) = (num(&w, "width")?, num(&h, "height")?);
+            let (nx, ny) = (count(&Dynamic::from_int(nx), "nx")?, count(&Dynamic::from_int(ny), "ny")?);
+            Ok(ClothHandle(Shared::new(ClothModel::grid(w, h, nx, ny, f.0)?)))
+        });
+    register!(
+        engine,
+        "cloth_obj",
+        ["path: String", "fabric: Fabric", "Cloth"],
+        "A cloth from an OBJ mesh whose texture coordinates are the flat pattern (m).",
+        |path: &str, f: Fabric| -> RResult<ClothHandle> {
+            let mesh = read_obj(Path::new(path))?;
+            Ok(ClothHandle(Shared::new(ClothModel::from_mesh(mesh, f.0)?)))
+        }
+    );
+    getter!(
+        engine,
+        "vertex_count",
+        ["cloth: Cloth", "int"],
+        "Number of particles.",
+        |c: &mut ClothHandle| c.0.particle_count() as INT
+    );
+    getter!(
+        engine,
+        "triangle_count",
+        ["cloth: Cloth", "int"],
+        "Number of triangles.",
+        |c: &mut ClothHandle| c.0.mesh.triangles.len() as INT
+    );
+    getter!(
+        engine,
+        "fabric",
+        ["cloth: Cloth", "Fabric"],
+        "The fabric the cloth was built with.",
+        |c: &mut ClothHandle| Fabric(c.0.fabric)
+    );
+    register!(
+        engine,
+        "to_string",
+        ["cloth: Cloth", "String"],
+        "One-line summary of a cloth.",
+        |c: &mut ClothHandle| c.to_string()
+    );
+    register!(
+        engine,
+        "to_debug",
+        ["cloth: Cloth", "String"],
+        "One-line summary of a cloth.",
+        |c: &mut ClothHandle| c.to_string()
+    );
+}

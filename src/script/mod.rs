@@ -1,0 +1,134 @@
+//! Rhai scripting: a thin layer that registers the engine's types and functions with a Rhai
+//! [`Engine`] and owns nothing else. Scripts build fabrics, cloths and simulations, run them
+//! and write meshes, statistics and pictures; all numeric work stays in Rust.
+//!
+//! - [`convert`]: error conversion, numbers and vectors, `…Parameters` ⇄ object maps;
+//! - [`fabric`]: the `Fabric` value type and the `Cloth` handle (`fabric()`, `cloth_grid`, …);
+//! - [`sim`]: the `Simulation` handle: constraints, stepping, runs with per-frame callbacks;
+//! - [`output`]: positions, bounds, energies, OBJ/glTF/CSV/JSON/PNG output;
+//! - [`run`], [`repl`], [`docs`]: running a file, the interactive loop, API documentation.
+//!
+//! Big objects cross into Rhai as shared handles (`Shared<Locked<_>>`), never copied per call.
+
+pub mod convert;
+pub mod docs;
+pub mod fabric;
+pub mod output;
+pub mod repl;
+pub mod run;
+pub mod sim;
+
+use rhai::{Dynamic, Engine};
+
+pub use fabric::{ClothHandle, Fabric};
+pub use run::{run_file, ScriptError};
+pub use sim::SimHandle;
+
+/// Registers a documented global function: name, parameter infos (the last one is the
+/// return type), doc text (plain lines, turned into `///` comments) and the closure.
+macro_rules! register {
+    ($engine:expr, $name:expr, [$($p:expr),* $(,)?], $doc:expr, $f:expr) => {
+        rhai::FuncRegistration::new($name)
+            .with_params_info::<&str>([$($p),*])
+            .with_comments([$crate::script::convert::doc_comment($doc)])
+            .register_into_engine($engine, $f)
+    };
+}
+
+/// Registers a documented property getter `obj.prop`.
+macro_rules! getter {
+    ($engine:expr, $prop:expr, [$($p:expr),* $(,)?], $doc:expr, $f:expr) => {
+        rhai::FuncRegistration::new_getter($prop)
+            .with_params_info::<&str>([$($p),*])
+            .with_comments([$crate::script::convert::doc_comment($doc)])
+            .register_into_engine($engine, $f)
+    };
+}
+pub(crate) use {getter, register};
+
+/// Limits that keep a runaway script from hanging or exhausting memory.
+#[derive(Debug, Clone, Copy)]
+pub struct EngineLimits {
+    /// Script operations per run (a native `sim.run` counts as one).
+    pub max_operations: u64,
+    /// Expression nesting depth (global, inside functions).
+    pub max_expr_depths: (usize, usize),
+    /// Longest string (bytes).
+    pub max_string_size: usize,
+    /// Largest array (elements).
+    pub max_array_size: usize,
+    /// Largest object map (entries).
+    pub max_map_size: usize,
+    /// Deepest script function recursion.
+    pub max_call_levels: usize,
+}
+
+impl Default for EngineLimits {
+    fn default() -> Self {
+        EngineLimits {
+            max_operations: 50_000_000,
+            max_expr_depths: (128, 64),
+            max_string_size: 16 << 20,
+            max_array_size: 10_000_000,
+            max_map_size: 100_000,
+            max_call_levels: 64,
+        }
+    }
+}
+
+/// An engine with every emilion function registered and the default [`EngineLimits`].
+pub fn build_engine() -> Engine {
+    build_engine_with(EngineLimits::default())
+}
+
+/// An engine with every emilion function registered and the given limits. `print` goes to
+/// stdout, `debug` to stderr.
+pub fn build_engine_with(limits: EngineLimits) -> Engine {
+    let mut engine = Engine::new();
+    engine
+        .set_max_operations(limits.max_operations)
+        .set_max_expr_depths(limits.max_expr_depths.0, limits.max_expr_depths.1)
+        .set_max_string_size(limits.max_string_size)
+        .set_max_array_size(limits.max_array_size)
+        .set_max_map_size(limits.max_map_size)
+        .set_max_call_levels(limits.max_call_levels);
+    engine.on_print(|s| println!("{s}"));
+    engine.on_debug(|s, src, pos| match src {
+        Some(src) => eprintln!("{src}:{pos:?}: {s}"),
+        None => eprintln!("{pos:?}: {s}"),
+    });
+    fabric::register(&mut engine);
+    sim::register(&mut engine);
+    output::register(&mut engine);
+    engine
+}
+
+/// A human-readable rendering of a script value (handles print their summary).
+pub fn describe(v: &Dynamic) -> String {
+    if let Some(f) = v.read_lock::<Fabric>() {
+        return f.to_string();
+    }
+    if let Some(c) = v.read_lock::<ClothHandle>() {
+        return c.to_string();
+    }
+    if let Some(s) = v.read_lock::<SimHandle>() {
+        return s.to_string();
+    }
+    if v.is_string() {
+        return format!("{v:?}");
+    }
+    v.to_string()
+}
+
+/// Names of the functions registered by emilion (not rhai's standard library), sorted and
+/// deduplicated; property accessors appear as `get$prop` / `set$prop`.
+pub fn function_names(engine: &Engine) -> Vec<String> {
+    let mut names: Vec<String> = engine
+        .gen_fn_signatures(false)
+        .iter()
+        .map(|s| s.split('(').next().unwrap_or("").to_string())
+        .collect();
+    names.sort();
+    names.dedup();
+    names
+}

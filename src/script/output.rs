@@ -1,0 +1,204 @@
+//! Script bindings that read a simulation out: positions, bounds, energies, statistics, and
+//! the files people open (OBJ and binary glTF meshes, CSV/JSON statistics, PNG pictures).
+
+use std::path::Path;
+
+use rhai::{Array, Dynamic, Engine, Map, INT};
+
+use super::convert::{arr3, count, finite, rt_err, to_map, RResult};
+use super::{register, SimHandle};
+use crate::cloth::{stats, Simulation};
+use crate::geometry::{mesh::bounds, write_glb, write_obj};
+use crate::render::{render_png, Camera, RenderMesh};
+
+/// Creates the parent folder of an output file.
+fn parent_dir(path: &str) -> RResult<()> {
+    match Path::new(path)
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+    {
+        Some(d) => std::fs::create_dir_all(d).map_err(|e| rt_err(format!("{}: {e}", d.display()))),
+        None => Ok(()),
+    }
+}
+
+/// A camera that frames the simulation's current bounds.
+fn auto_camera(sim: &Simulation, width: u32, height: u32) -> Camera {
+    let (lo, hi) = bounds(&sim.state.x);
+    Camera::framing(lo, hi, width, height)
+}
+
+/// A camera from `#{eye, target, up, fov, width, height}`; eye and target default to framing.
+fn camera(sim: &Simulation, m: &Map) -> RResult<Camera> {
+    const KEYS: [&str; 6] = ["eye", "target", "up", "fov", "width", "height"];
+    if let Some(k) = m.keys().find(|k| !KEYS.contains(&k.as_str())) {
+        return Err(rt_err(format!(
+            "unknown camera key `{k}` (known: {})",
+            KEYS.join(", ")
+        )));
+    }
+    let size = |k: &str, d: u32| -> RResult<u32> {
+        match m.get(k) {
+            Some(v) => match count(v, k)? {
+                0 => Err(rt_err(format!("`{k}` must be > 0"))),
+                n => Ok(n.min(16384) as u32),
+            },
+            None => Ok(d),
+        }
+    };
+    let mut cam = auto_camera(sim, size("width", 800)?, size("height", 600)?);
+    if let Some(v) = m.get("eye") {
+        cam.eye = super::convert::vec3(v, "eye")?.into();
+    }
+    if let Some(v) = m.get("target") {
+        cam.target = super::convert::vec3(v, "target")?.into();
+    }
+    if let Some(v) = m.get("up") {
+        cam.up = super::convert::vec3(v, "up")?.into();
+    }
+    if let Some(v) = m.get("fov") {
+        cam.fov_y_deg = finite(v, "fov")?;
+    }
+    Ok(cam)
+}
+
+/// Renders the cloth's current shape to a PNG file.
+fn render(sim: &Simulation, path: &str, cam: &Camera) -> RResult<()> {
+    parent_dir(path)?;
+    let mesh = RenderMesh {
+        positions: &sim.state.x,
+        triangles: &sim.model.mesh.triangles,
+        color: RenderMesh::DEFAULT_COLOR,
+    };
+    render_png(Path::new(path), &[mesh], cam)?;
+    Ok(())
+}
+
+/// Registers the read-out and output methods of `Simulation`.
+pub fn register(engine: &mut Engine) {
+    register!(
+        engine,
+        "position",
+        ["sim: Simulation", "i: int", "Array"],
+        "Position [x, y, z] (m) of particle `i`.",
+        |h: &mut SimHandle, i: INT| -> RResult<Dynamic> {
+            let s = h.get()?;
+            let i = count(&Dynamic::from_int(i), "i")?;
+            let p = s.state.x.get(i).ok_or_else(|| {
+                rt_err(format!(
+                    "particle {i} out of range (cloth has {})",
+                    s.particle_count()
+                ))
+            })?;
+            Ok(arr3([p.x, p.y, p.z]))
+        }
+    );
+    register!(engine, "positions", ["sim: Simulation", "Array"],
+        "All positions as an array of [x, y, z] (for small cloths: about 0.5 µs per value in script).",
+        |h: &mut SimHandle| -> RResult<Array> { Ok(h.get()?.state.x.iter().map(|p| arr3([p.x, p.y, p.z])).collect()) });
+    register!(
+        engine,
+        "bounds",
+        ["sim: Simulation", "Map"],
+        "Axis-aligned bounds of the current positions: #{min: [x, y, z], max: [x, y, z]}.",
+        |h: &mut SimHandle| -> RResult<Map> {
+            let (lo, hi) = bounds(&h.get()?.state.x);
+            let mut m = Map::new();
+            m.insert("min".into(), arr3([lo.x, lo.y, lo.z]));
+            m.insert("max".into(), arr3([hi.x, hi.y, hi.z]));
+            Ok(m)
+        }
+    );
+    register!(
+        engine,
+        "energy",
+        ["sim: Simulation", "Map"],
+        "Energies of the current state (J): #{kinetic, gravity, elastic, total}.",
+        |h: &mut SimHandle| -> RResult<Map> {
+            let (k, g, e) = h.get_mut()?.energy();
+            let mut m = Map::new();
+            for (name, v) in [
+                ("kinetic", k),
+                ("gravity", g),
+                ("elastic", e),
+                ("total", k + g + e),
+            ] {
+                m.insert(name.into(), Dynamic::from_float(v));
+            }
+            Ok(m)
+        }
+    );
+    register!(engine, "stats", ["sim: Simulation", "Map"],
+        "Statistics of the last step: #{step, time, kinetic, gravity, elastic, total, cg_iterations,\nresidual, converged, assemble_ms, solve_ms, step_ms}; empty before the first step.",
+        |h: &mut SimHandle| -> RResult<Dynamic> {
+            Ok(h.get()?.stats.last().map(to_map).unwrap_or_else(|| Dynamic::from_map(Map::new())))
+        });
+    register!(engine, "save_obj", ["sim: Simulation", "path: String"],
+        "Writes the current shape as OBJ, with the rest (pattern) coordinates as texture coordinates.",
+        |h: &mut SimHandle, path: &str| -> RResult<()> {
+            parent_dir(path)?;
+            let s = h.get()?;
+            write_obj(Path::new(path), &s.state.x, &s.model.mesh.triangles, Some(&s.model.mesh.rest))?;
+            Ok(())
+        });
+    register!(
+        engine,
+        "save_glb",
+        ["sim: Simulation", "path: String"],
+        "Writes the current shape as binary glTF (.glb).",
+        |h: &mut SimHandle, path: &str| -> RResult<()> {
+            parent_dir(path)?;
+            let s = h.get()?;
+            write_glb(Path::new(path), &s.state.x, &s.model.mesh.triangles)?;
+            Ok(())
+        }
+    );
+    register!(
+        engine,
+        "save_stats_csv",
+        ["sim: Simulation", "path: String"],
+        "Writes the statistics of every step as CSV (one line per step).",
+        |h: &mut SimHandle, path: &str| -> RResult<()> {
+            Ok(stats::write_csv(Path::new(path), &h.get()?.stats)?)
+        }
+    );
+    register!(
+        engine,
+        "save_stats_json",
+        ["sim: Simulation", "path: String"],
+        "Writes the statistics of every step as a JSON array.",
+        |h: &mut SimHandle, path: &str| -> RResult<()> {
+            Ok(stats::write_json(Path::new(path), &h.get()?.stats)?)
+        }
+    );
+    register!(
+        engine,
+        "render",
+        ["sim: Simulation", "path: String"],
+        "Renders the cloth to an 800×600 PNG with a camera that frames it.",
+        |h: &mut SimHandle, path: &str| -> RResult<()> {
+            let s = h.get()?;
+            render(&s, path, &auto_camera(&s, 800, 600))
+        }
+    );
+    register!(engine, "render", ["sim: Simulation", "path: String", "camera: Map", "()"],
+        "Renders the cloth to a PNG with a camera #{eye: [..], target: [..], up: [..], fov: degrees,\nwidth, height}; missing entries come from the auto-framing 800×600 camera.",
+        |h: &mut SimHandle, path: &str, m: Map| -> RResult<()> {
+            let s = h.get()?;
+            render(&s, path, &camera(&s, &m)?)
+        });
+    register!(
+        engine,
+        "to_string",
+        ["sim: Simulation", "String"],
+        "One-line summary of a simulation.",
+        |h: &mut SimHandle| h.to_string()
+    );
+    register!(
+        engine,
+        "to_debug",
+        ["sim: Simulation", "String"],
+        "One-line summary of a simulation.",
+        |h: &mut SimHandle| h.to_string()
+    );
+}

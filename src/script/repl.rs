@@ -1,0 +1,257 @@
+//! The interactive loop: a rustyline editor with history (`~/.emilion_history`), multi-line
+//! input (a trailing `\` or unbalanced brackets continue with `...> `), tab completion of the
+//! registered function names, and one persistent Scope. Results print as `=> value`; errors
+//! print and the loop goes on. On a non-terminal stdin it reads plain lines, without prompts.
+
+use std::io::{BufRead, IsTerminal, Write};
+use std::path::{Path, PathBuf};
+
+use rhai::{Dynamic, Engine, Scope, AST};
+use rustyline::completion::Completer;
+use rustyline::error::ReadlineError;
+use rustyline::highlight::Highlighter;
+use rustyline::hint::Hinter;
+use rustyline::validate::Validator;
+use rustyline::{Context, Editor, Helper};
+
+use super::run::ScriptError;
+use super::{build_engine, describe, docs, function_names};
+
+const PROMPT: &str = "emilion> ";
+const MORE: &str = "...> ";
+
+/// Tab completion over the engine's function names.
+struct ReplHelper {
+    names: Vec<String>,
+}
+
+impl Completer for ReplHelper {
+    type Candidate = String;
+    fn complete(
+        &self,
+        line: &str,
+        pos: usize,
+        _: &Context<'_>,
+    ) -> rustyline::Result<(usize, Vec<String>)> {
+        let start = line[..pos]
+            .rfind(|c: char| !(c.is_alphanumeric() || c == '_'))
+            .map_or(0, |i| i + 1);
+        let word = &line[start..pos];
+        let found = self
+            .names
+            .iter()
+            .filter(|n| !word.is_empty() && n.starts_with(word))
+            .cloned()
+            .collect();
+        Ok((start, found))
+    }
+}
+impl Hinter for ReplHelper {
+    type Hint = String;
+}
+impl Highlighter for ReplHelper {}
+impl Validator for ReplHelper {}
+impl Helper for ReplHelper {}
+
+/// Whether `input` is unfinished: a trailing `\`, or more brackets opened than closed
+/// (outside strings and `//` comments).
+pub fn needs_more(input: &str) -> bool {
+    if input.trim_end().ends_with('\\') {
+        return true;
+    }
+    let mut depth = 0i64;
+    let mut chars = input.chars().peekable();
+    let mut quote: Option<char> = None;
+    while let Some(c) = chars.next() {
+        match quote {
+            Some(q) => {
+                if c == '\\' {
+                    chars.next();
+                } else if c == q {
+                    quote = None;
+                }
+            }
+            None => match c {
+                '"' | '`' => quote = Some(c),
+                '/' if chars.peek() == Some(&'/') => {
+                    while chars.next_if(|&c| c != '\n').is_some() {}
+                }
+                '(' | '[' | '{' => depth += 1,
+                ')' | ']' | '}' => depth -= 1,
+                _ => {}
+            },
+        }
+    }
+    depth > 0 || quote == Some('`')
+}
+
+/// The REPL's state: engine, persistent scope, and the functions defined so far.
+pub struct Session {
+    engine: Engine,
+    scope: Scope<'static>,
+    ast: AST,
+}
+
+/// What to do after a line.
+enum Flow {
+    Continue,
+    Quit,
+}
+
+impl Session {
+    /// A fresh session with every emilion function registered.
+    pub fn new() -> Self {
+        Session {
+            engine: build_engine(),
+            scope: Scope::new(),
+            ast: AST::empty(),
+        }
+    }
+
+    /// Evaluates `input` in the persistent scope; functions it defines stay available.
+    pub fn eval(&mut self, input: &str) -> Result<Dynamic, ScriptError> {
+        let ast = self
+            .engine
+            .compile_with_scope(&self.scope, input)
+            .map_err(|e| ScriptError::at("<repl>", input, e.1, e.0.to_string()))?;
+        self.ast += ast;
+        let r = self
+            .engine
+            .eval_ast_with_scope::<Dynamic>(&mut self.scope, &self.ast);
+        self.ast.clear_statements();
+        r.map_err(|e| ScriptError::from_rhai("<repl>", input, *e))
+    }
+
+    /// Handles one complete input: a command or code. Prints results and errors.
+    fn handle(&mut self, input: &str, out: &mut impl Write) -> Flow {
+        let cmd = input.trim();
+        match cmd {
+            "" => return Flow::Continue,
+            "quit" | "exit" => return Flow::Quit,
+            "help" => {
+                let _ = writeln!(out, "Type Rhai code; `help NAME` shows the docs of the functions whose name starts with NAME;\n`quit` or `exit` leaves. Functions:");
+                let _ = write!(out, "{}", docs::help_text(&self.engine, ""));
+                return Flow::Continue;
+            }
+            _ => {}
+        }
+        if let Some(pat) = cmd.strip_prefix("help ") {
+            let text = docs::help_text(&self.engine, pat.trim());
+            let _ = write!(
+                out,
+                "{}",
+                if text.is_empty() {
+                    format!("no function matches `{}`\n", pat.trim())
+                } else {
+                    text
+                }
+            );
+            return Flow::Continue;
+        }
+        match self.eval(input) {
+            Ok(v) if v.is_unit() => {}
+            Ok(v) => {
+                let _ = writeln!(out, "=> {}", describe(&v));
+            }
+            Err(e) => eprintln!("{e}"),
+        }
+        let _ = out.flush();
+        Flow::Continue
+    }
+
+    /// Runs a script file in the session (its variables and functions stay).
+    pub fn run_init(&mut self, path: &Path) -> Result<(), ScriptError> {
+        let file = path.display().to_string();
+        let src = std::fs::read_to_string(path).map_err(|e| ScriptError {
+            file: file.clone(),
+            position: None,
+            message: e.to_string(),
+            source_line: None,
+        })?;
+        self.eval(&src)
+            .map(|_| ())
+            .map_err(|e| ScriptError { file, ..e })
+    }
+}
+
+impl Default for Session {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+fn history_path() -> PathBuf {
+    match std::env::var_os("HOME") {
+        Some(h) => PathBuf::from(h).join(".emilion_history"),
+        None => PathBuf::from(".emilion_history"),
+    }
+}
+
+/// Runs the REPL on stdin, after `init` if given.
+pub fn repl(init: Option<&Path>) -> Result<(), String> {
+    let mut session = Session::new();
+    if let Some(p) = init {
+        if let Err(e) = session.run_init(p) {
+            eprintln!("{e}");
+        }
+    }
+    let mut stdout = std::io::stdout();
+    if !std::io::stdin().is_terminal() {
+        let mut buf = String::new();
+        for line in std::io::stdin().lock().lines() {
+            let line = line.map_err(|e| e.to_string())?;
+            push_line(&mut buf, &line);
+            if needs_more(&buf) {
+                continue;
+            }
+            let flow = session.handle(&std::mem::take(&mut buf), &mut stdout);
+            if matches!(flow, Flow::Quit) {
+                return Ok(());
+            }
+        }
+        if !buf.trim().is_empty() {
+            session.handle(&buf, &mut stdout);
+        }
+        return Ok(());
+    }
+    let mut rl: Editor<ReplHelper, rustyline::history::DefaultHistory> =
+        Editor::new().map_err(|e| e.to_string())?;
+    let mut names = function_names(&session.engine);
+    names.retain(|n| !n.contains('$'));
+    names.extend(["help", "quit", "exit"].map(String::from));
+    rl.set_helper(Some(ReplHelper { names }));
+    let hist = history_path();
+    let _ = rl.load_history(&hist);
+    println!("emilion REPL: type `help` for the functions, `quit` to leave.");
+    let mut buf = String::new();
+    loop {
+        match rl.readline(if buf.is_empty() { PROMPT } else { MORE }) {
+            Ok(line) => {
+                push_line(&mut buf, &line);
+                if needs_more(&buf) {
+                    continue;
+                }
+                let input = std::mem::take(&mut buf);
+                let _ = rl.add_history_entry(input.trim_end());
+                if matches!(session.handle(&input, &mut stdout), Flow::Quit) {
+                    break;
+                }
+            }
+            Err(ReadlineError::Interrupted) => buf.clear(),
+            Err(ReadlineError::Eof) => break,
+            Err(e) => return Err(e.to_string()),
+        }
+    }
+    let _ = rl.save_history(&hist);
+    Ok(())
+}
+
+/// Appends a line to the pending input, dropping a continuation `\`.
+fn push_line(buf: &mut String, line: &str) {
+    if buf.trim_end().ends_with('\\') {
+        let keep = buf.trim_end().len() - 1;
+        buf.truncate(keep);
+    }
+    buf.push_str(line);
+    buf.push('\n');
+}

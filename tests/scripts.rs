@@ -1,0 +1,254 @@
+//! The scripting layer end to end: every script under `scripts/` runs and writes its files,
+//! errors carry script positions, the binary's `run`, `repl` and `doc` subcommands work, and
+//! every registered function is used by some script.
+#![cfg(feature = "scripting")]
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+use emilion::script::{build_engine, function_names, run_file};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A fresh, empty folder under the target's test temp dir.
+fn temp_dir(name: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("scripts")
+        .join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn script_paths() -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("scripts"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "rhai"))
+        .collect();
+    v.sort();
+    v
+}
+
+/// Runs `scripts/NAME.rhai` with `out` set to a temp folder; returns the folder.
+fn run_script(name: &str) -> PathBuf {
+    let out = temp_dir(name);
+    let sets = vec![("out".to_string(), out.display().to_string())];
+    if let Err(e) = run_file(&root().join("scripts").join(format!("{name}.rhai")), &sets) {
+        panic!("scripts/{name}.rhai failed:\n{e}");
+    }
+    out
+}
+
+fn assert_files(dir: &Path, files: &[&str]) {
+    for f in files {
+        let p = dir.join(f);
+        let len = std::fs::metadata(&p)
+            .unwrap_or_else(|_| panic!("{} missing", p.display()))
+            .len();
+        assert!(len > 0, "{} is empty", p.display());
+    }
+}
+
+#[test]
+fn hang_script() {
+    let out = run_script("hang");
+    assert_files(&out, &["hang.png", "hang.obj", "hang_stats.csv"]);
+}
+
+#[test]
+fn drop_script() {
+    let out = run_script("drop");
+    assert_files(&out, &["drop.png", "drop.glb"]);
+}
+
+#[test]
+fn demo_script() {
+    let out = run_script("demo");
+    assert_files(
+        &out,
+        &["demo.png", "demo.obj", "demo.glb", "demo_stats.csv"],
+    );
+}
+
+#[test]
+fn tour_script() {
+    let out = run_script("tour");
+    assert_files(
+        &out.join("tour"),
+        &[
+            "tour.png",
+            "tour_small.png",
+            "tour.obj",
+            "tour.glb",
+            "tour_stats.csv",
+            "tour_stats.json",
+        ],
+    );
+}
+
+#[test]
+fn other_scripts_run() {
+    for p in script_paths() {
+        let name = p.file_stem().unwrap().to_str().unwrap().to_string();
+        if ["hang", "drop", "demo", "tour"].contains(&name.as_str()) {
+            continue;
+        }
+        let out = run_script(&name);
+        for e in std::fs::read_dir(&out).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_file() {
+                assert!(
+                    std::fs::metadata(&p).unwrap().len() > 0,
+                    "{} is empty",
+                    p.display()
+                );
+            }
+        }
+    }
+}
+
+fn write_script(name: &str, body: &str) -> PathBuf {
+    let p = temp_dir(name).join(format!("{name}.rhai"));
+    std::fs::write(&p, body).unwrap();
+    p
+}
+
+#[test]
+fn error_names_the_line() {
+    let p = write_script(
+        "bad_grid",
+        "let x = 1;\nlet y = cloth_grid(-1.0, 1.0, 4, 4, fabric());\n",
+    );
+    let e = run_file(&p, &[]).expect_err("a negative width must fail");
+    let text = e.to_string();
+    assert_eq!(e.position.map(|p| p.0), Some(2), "{text}");
+    assert!(text.contains(":2:"), "{text}");
+    assert!(
+        text.contains("cloth_grid(-1.0"),
+        "the source line is shown: {text}"
+    );
+}
+
+#[test]
+fn negative_density_is_named() {
+    let p = write_script("bad_fabric", "let f = fabric(#{ density: -1 });\n");
+    let text = run_file(&p, &[])
+        .expect_err("negative density must fail")
+        .to_string();
+    assert!(text.contains("density"), "{text}");
+    let p = write_script("bad_fabric_set", "let f = fabric();\nf.shear = -2.0;\n");
+    let text = run_file(&p, &[])
+        .expect_err("negative shear must fail")
+        .to_string();
+    assert!(text.contains("shear") && text.contains(":2:"), "{text}");
+    let p = write_script("bad_key", "let f = fabric(#{ densty: 0.1 });\n");
+    let text = run_file(&p, &[])
+        .expect_err("unknown keys must fail")
+        .to_string();
+    assert!(text.contains("densty"), "{text}");
+}
+
+#[test]
+fn set_values_are_typed() {
+    let p = write_script(
+        "sets",
+        "if n != 3 || x != 0.5 || !flag || name != \"abc\" { throw \"wrong --set values\"; }\n",
+    );
+    let sets: Vec<(String, String)> = [("n", "3"), ("x", "0.5"), ("flag", "true"), ("name", "abc")]
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+    run_file(&p, &sets).unwrap();
+}
+
+#[test]
+fn binary_reports_script_errors() {
+    let p = write_script(
+        "bin_bad",
+        "let x = 1;\nlet y = cloth_grid(-1.0, 1.0, 4, 4, fabric());\n",
+    );
+    let o = Command::new(env!("CARGO_BIN_EXE_emilion"))
+        .arg("run")
+        .arg(&p)
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(stderr.contains(&format!("{}:2:", p.display())), "{stderr}");
+}
+
+#[test]
+fn repl_reads_piped_lines() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_emilion"))
+        .arg("repl")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(b"let f = fabric();\nf.density = 0.25;\nf.density * 2.0\n")
+        .unwrap();
+    let o = child.wait_with_output().unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(stdout.contains("=> 0.5"), "{stdout}");
+}
+
+/// How a registered name shows in scripts: `name(` for functions, `.prop` for properties.
+fn usage(name: &str) -> String {
+    if let Some(p) = name.strip_prefix("get$") {
+        format!(".{p}")
+    } else if let Some(p) = name.strip_prefix("set$") {
+        format!(".{p} =")
+    } else {
+        format!("{name}(")
+    }
+}
+
+#[test]
+fn every_function_is_used_by_a_script() {
+    let all: String = script_paths()
+        .iter()
+        .map(|p| std::fs::read_to_string(p).unwrap())
+        .collect();
+    let names = function_names(&build_engine());
+    assert!(names.len() > 30, "{names:?}");
+    let unused: Vec<_> = names.iter().filter(|n| !all.contains(&usage(n))).collect();
+    assert!(
+        unused.is_empty(),
+        "registered but used by no script: {unused:?}"
+    );
+}
+
+#[test]
+fn doc_lists_every_function() {
+    let dir = temp_dir("doc");
+    let o = Command::new(env!("CARGO_BIN_EXE_emilion"))
+        .arg("doc")
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let md = std::fs::read_to_string(dir.join("api.md")).unwrap();
+    let json = std::fs::read_to_string(dir.join("api.json")).unwrap();
+    assert!(json.contains("\"functions\""));
+    for n in function_names(&build_engine()) {
+        let shown = match n.split_once('$') {
+            Some((_, p)) => format!("`.{p}`"),
+            None => format!("`{n}`"),
+        };
+        assert!(md.contains(&shown), "api.md does not document {n}");
+    }
+    assert!(
+        md.contains("cloth_grid(width: float"),
+        "signatures carry parameter names"
+    );
+}
