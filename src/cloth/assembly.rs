@@ -8,7 +8,7 @@
 
 use rayon::prelude::*;
 
-use super::bcsr::Bcsr3;
+use super::bcsr::{Bcsr3, Sym3f};
 use super::model::ClothModel;
 use super::parallel::{chunks, ordered_sum, SyncPtr, CHUNK};
 use crate::geometry::{Mat3, Vec3};
@@ -316,7 +316,7 @@ impl Assembly {
                             }
                             if mirror {
                                 for s in row_ptr[i]..row_ptr[i + 1] {
-                                    *values32.at(s) = (*values.at(s)).cast::<f32>();
+                                    *values32.at(s) = Sym3f::from_upper(&*values.at(s));
                                 }
                             }
                             let d = *values.at(diag[i]);

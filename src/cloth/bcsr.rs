@@ -22,11 +22,42 @@ pub struct Bcsr3 {
     pub diag: Vec<usize>,
     /// Optional single-precision mirror of `values` (empty unless enabled), read by the
     /// multigrid smoother where memory traffic, not precision, is the cost.
-    pub values32: Vec<Mat3f>,
+    pub values32: Vec<Sym3f>,
 }
 
 /// 3×3 single-precision block.
 pub type Mat3f = nalgebra::Matrix3<f32>;
+
+/// A symmetric 3×3 block in single precision: (xx, xy, xz, yy, yz, zz). The multigrid
+/// smoother is bound by memory traffic, and on grid cloths every block is symmetric.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Sym3f(pub [f32; 6]);
+
+impl Sym3f {
+    /// The upper triangle of `m`, rounded to single precision.
+    #[inline]
+    pub fn from_upper(m: &Mat3) -> Self {
+        Sym3f([
+            m[(0, 0)] as f32,
+            m[(0, 1)] as f32,
+            m[(0, 2)] as f32,
+            m[(1, 1)] as f32,
+            m[(1, 2)] as f32,
+            m[(2, 2)] as f32,
+        ])
+    }
+
+    /// `self · x`, accumulated in double precision.
+    #[inline]
+    pub fn mul(&self, x: &Vec3) -> Vec3 {
+        let [a, b, c, d, e, f] = self.0.map(f64::from);
+        Vec3::new(
+            a * x.x + b * x.y + c * x.z,
+            b * x.x + d * x.y + e * x.z,
+            c * x.x + e * x.y + f * x.z,
+        )
+    }
+}
 
 impl Bcsr3 {
     /// Builds the symmetric pattern of an `n`-row matrix holding every diagonal block and both
@@ -90,9 +121,10 @@ impl Bcsr3 {
         });
     }
 
-    /// Allocates the single-precision mirror (filled by whoever fills `values`).
+    /// Allocates the single-precision symmetric mirror (filled by whoever fills `values`;
+    /// only valid when every block is symmetric, as on grid cloths).
     pub fn enable_mirror32(&mut self) {
-        self.values32 = vec![Mat3f::zeros(); self.values.len()];
+        self.values32 = vec![Sym3f::default(); self.values.len()];
     }
 
     /// Row `i` of `A x` with the single-precision mirror, reading `x` through a raw pointer.
@@ -104,7 +136,7 @@ impl Bcsr3 {
         let mut acc = Vec3::zeros();
         for k in self.row_ptr[i]..self.row_ptr[i + 1] {
             let xj = unsafe { *x.add(self.cols[k] as usize) };
-            acc += self.values32[k].cast::<f64>() * xj;
+            acc += self.values32[k].mul(&xj);
         }
         acc
     }

@@ -5,7 +5,7 @@
 //! factorised exactly once per step; lines are swept in three colours (lines three apart never
 //! share an element), so lines of one colour are solved in parallel. No allocation per step.
 
-use super::bcsr::{Bcsr3, Mat3f};
+use super::bcsr::{Bcsr3, Mat3f, Sym3f};
 use super::parallel::{for_each_index, SyncPtr, PAR_MIN};
 use crate::geometry::{Mat3, Vec3};
 
@@ -25,10 +25,7 @@ struct Factors {
     prev1: Vec<usize>,
     prev2: Vec<usize>,
     /// Inverse pivots (single precision: a preconditioner, bounded by memory traffic).
-    g: Vec<Mat3f>,
-    /// Multipliers for the previous and the one before.
-    l1: Vec<Mat3f>,
-    l2: Vec<Mat3f>,
+    g: Vec<Sym3f>,
     /// Upper blocks to the next and the one after.
     u1: Vec<Mat3f>,
     u2: Vec<Mat3f>,
@@ -62,9 +59,7 @@ impl LineSolver {
             Factors {
                 prev1: (0..n).map(|k| slot(k, stride, pos(k) >= 1)).collect(),
                 prev2: (0..n).map(|k| slot(k, 2 * stride, pos(k) >= 2)).collect(),
-                g: z.clone(),
-                l1: z.clone(),
-                l2: z.clone(),
+                g: vec![Sym3f::default(); n],
                 u1: z.clone(),
                 u2: z,
             }
@@ -107,10 +102,8 @@ impl LineSolver {
                 LineDir::Warp => ny,
                 LineDir::Weft => nx,
             };
-            let (gp, l1p, l2p, u1p, u2p) = (
+            let (gp, u1p, u2p) = (
                 SyncPtr(f.g.as_mut_ptr()),
-                SyncPtr(f.l1.as_mut_ptr()),
-                SyncPtr(f.l2.as_mut_ptr()),
                 SyncPtr(f.u1.as_mut_ptr()),
                 SyncPtr(f.u2.as_mut_ptr()),
             );
@@ -123,64 +116,71 @@ impl LineSolver {
                     a.values[slot]
                 }
             };
-            for_each_index(nl, nx * ny >= PAR_MIN, |line| {
-                let (first, s, len) = Self::line(nx, ny, dir, line);
-                // factors of the two previous rows, kept in double precision
-                let (mut g_1, mut u1_1, mut u2_1) = (Mat3::zeros(), Mat3::zeros(), Mat3::zeros());
-                let (mut g_2, mut u1_2, mut u2_2) = (Mat3::zeros(), Mat3::zeros(), Mat3::zeros());
+            // lines in lockstep groups, so that weft lines walk memory row by row
+            let group = group_size(dir);
+            for_each_index(nl.div_ceil(group), nx * ny >= PAR_MIN, |gi| {
+                let lines = gi * group..((gi + 1) * group).min(nl);
+                let (_, s, len) = Self::line(nx, ny, dir, 0);
+                // factors of the two previous rows of each line, kept in double precision
+                let z = [Mat3::zeros(); GROUP];
+                let (mut g_1, mut u1_1, mut u2_1) = (z, z, z);
+                let (mut g_2, mut u1_2, mut u2_2) = (z, z, z);
                 for t in 0..len {
-                    let k = first + t * s;
-                    let a2 = if t >= 2 {
-                        blk(k, 2 * s, prev2[k])
-                    } else {
-                        Mat3::zeros()
-                    };
-                    let mut a1 = if t >= 1 {
-                        blk(k, s, prev1[k])
-                    } else {
-                        Mat3::zeros()
-                    };
-                    let mut d = if fixed[k] {
-                        Mat3::identity()
-                    } else {
-                        a.values[a.diag[k]]
-                    };
-                    // eliminate column k − 2s, then column k − s
-                    let l2 = if t >= 2 { a2 * g_2 } else { Mat3::zeros() };
-                    if t >= 2 {
-                        a1 -= l2 * u1_2;
-                        d -= l2 * u2_2;
+                    for line in lines.clone() {
+                        let q = line - lines.start;
+                        let first = Self::line(nx, ny, dir, line).0;
+                        let k = first + t * s;
+                        let a2 = if t >= 2 {
+                            blk(k, 2 * s, prev2[k])
+                        } else {
+                            Mat3::zeros()
+                        };
+                        let mut a1 = if t >= 1 {
+                            blk(k, s, prev1[k])
+                        } else {
+                            Mat3::zeros()
+                        };
+                        let mut d = if fixed[k] {
+                            Mat3::identity()
+                        } else {
+                            a.values[a.diag[k]]
+                        };
+                        // eliminate column k − 2s, then column k − s
+                        let l2 = if t >= 2 { a2 * g_2[q] } else { Mat3::zeros() };
+                        if t >= 2 {
+                            a1 -= l2 * u1_2[q];
+                            d -= l2 * u2_2[q];
+                        }
+                        let l1 = if t >= 1 { a1 * g_1[q] } else { Mat3::zeros() };
+                        if t >= 1 {
+                            d -= l1 * u1_1[q];
+                        }
+                        let g = d.try_inverse().unwrap_or_else(Mat3::identity);
+                        // upper blocks (k, k + s), (k, k + 2s): transposes of later rows' lower blocks
+                        // (A is symmetric), minus the fill from column k − s
+                        let mut u1 = if t + 1 < len {
+                            blk(k + s, s, prev1[k + s]).transpose()
+                        } else {
+                            Mat3::zeros()
+                        };
+                        let u2 = if t + 2 < len {
+                            blk(k + 2 * s, 2 * s, prev2[k + 2 * s]).transpose()
+                        } else {
+                            Mat3::zeros()
+                        };
+                        if t >= 1 && t + 1 < len {
+                            u1 -= l1 * u2_1[q];
+                        }
+                        // SAFETY: each particle belongs to exactly one line of this direction.
+                        unsafe {
+                            // W is a Schur complement of a symmetric matrix: G is symmetric
+                            *gp.at(k) = Sym3f::from_upper(&g);
+                            *u1p.at(k) = u1.cast::<f32>();
+                            *u2p.at(k) = u2.cast::<f32>();
+                        }
+                        (g_2[q], u1_2[q], u2_2[q]) = (g_1[q], u1_1[q], u2_1[q]);
+                        (g_1[q], u1_1[q], u2_1[q]) = (g, u1, u2);
                     }
-                    let l1 = if t >= 1 { a1 * g_1 } else { Mat3::zeros() };
-                    if t >= 1 {
-                        d -= l1 * u1_1;
-                    }
-                    let g = d.try_inverse().unwrap_or_else(Mat3::identity);
-                    // upper blocks (k, k + s), (k, k + 2s): transposes of later rows' lower blocks
-                    // (A is symmetric), minus the fill from column k − s
-                    let mut u1 = if t + 1 < len {
-                        blk(k + s, s, prev1[k + s]).transpose()
-                    } else {
-                        Mat3::zeros()
-                    };
-                    let u2 = if t + 2 < len {
-                        blk(k + 2 * s, 2 * s, prev2[k + 2 * s]).transpose()
-                    } else {
-                        Mat3::zeros()
-                    };
-                    if t >= 1 && t + 1 < len {
-                        u1 -= l1 * u2_1;
-                    }
-                    // SAFETY: each particle belongs to exactly one line of this direction.
-                    unsafe {
-                        *gp.at(k) = g.cast::<f32>();
-                        *l1p.at(k) = l1.cast::<f32>();
-                        *l2p.at(k) = l2.cast::<f32>();
-                        *u1p.at(k) = u1.cast::<f32>();
-                        *u2p.at(k) = u2.cast::<f32>();
-                    }
-                    (g_2, u1_2, u2_2) = (g_1, u1_1, u2_1);
-                    (g_1, u1_1, u2_1) = (g, u1, u2);
                 }
             });
         }
@@ -206,41 +206,65 @@ impl LineSolver {
         };
         let yp = SyncPtr(self.y.as_mut_ptr());
         let ep = SyncPtr(e.as_mut_ptr());
+        let group = group_size(dir);
         for color in order {
             let count = (nl + 2 - color) / 3;
-            for_each_index(count, nx * ny >= PAR_MIN, |m| {
-                let line = color + 3 * m;
-                let (first, s, len) = Self::line(nx, ny, dir, line);
+            for_each_index(count.div_ceil(group), nx * ny >= PAR_MIN, |gi| {
+                let members = gi * group..((gi + 1) * group).min(count);
+                let (_, s, len) = Self::line(nx, ny, dir, 0);
                 // SAFETY: lines of one colour are three apart, so no element couples two of
-                // them: each task writes its own line's e and y and reads e of other colours only.
+                // them: each task writes its own lines' e and y and reads e of other colours only.
                 unsafe {
-                    // residual of the line, then forward elimination in place
+                    // residuals of the lines, then forward elimination in place, row by row
                     for t in 0..len {
-                        let k = first + t * s;
-                        let mut d = if fixed[k] {
-                            Vec3::zeros()
-                        } else {
-                            r[k] - a.row_times32_ptr(k, ep.0)
-                        };
-                        if t >= 1 {
-                            d -= f.l1[k].cast::<f64>() * *yp.at(k - s);
+                        for m in members.clone() {
+                            let k = Self::line(nx, ny, dir, color + 3 * m).0 + t * s;
+                            let mut d = if fixed[k] {
+                                Vec3::zeros()
+                            } else {
+                                r[k] - a.row_times32_ptr(k, ep.0)
+                            };
+                            // symmetric elimination: L(k, k−s) = U(k−s, k)ᵀ G(k−s); the
+                            // scratch holds w = G y, so the multiplier is never stored
+                            if t >= 1 {
+                                d -= f.u1[k - s].cast::<f64>().tr_mul(&*yp.at(k - s));
+                            }
+                            if t >= 2 {
+                                d -= f.u2[k - 2 * s].cast::<f64>().tr_mul(&*yp.at(k - 2 * s));
+                            }
+                            *yp.at(k) = f.g[k].mul(&d);
                         }
-                        if t >= 2 {
-                            d -= f.l2[k].cast::<f64>() * *yp.at(k - 2 * s);
-                        }
-                        *yp.at(k) = d;
                     }
-                    let (mut x1, mut x2) = (Vec3::zeros(), Vec3::zeros());
+                    let mut x1 = [Vec3::zeros(); GROUP];
+                    let mut x2 = [Vec3::zeros(); GROUP];
                     for t in (0..len).rev() {
-                        let k = first + t * s;
-                        let xk = f.g[k].cast::<f64>()
-                            * (*yp.at(k) - f.u1[k].cast::<f64>() * x1 - f.u2[k].cast::<f64>() * x2);
-                        *ep.at(k) += xk;
-                        x2 = x1;
-                        x1 = xk;
+                        for m in members.clone() {
+                            let q = m - members.start;
+                            let k = Self::line(nx, ny, dir, color + 3 * m).0 + t * s;
+                            let xk = *yp.at(k)
+                                - f.g[k].mul(
+                                    &(f.u1[k].cast::<f64>() * x1[q]
+                                        + f.u2[k].cast::<f64>() * x2[q]),
+                                );
+                            *ep.at(k) += xk;
+                            x2[q] = x1[q];
+                            x1[q] = xk;
+                        }
                     }
                 }
             });
         }
+    }
+}
+
+/// Most lines processed in lockstep by one task.
+const GROUP: usize = 16;
+
+/// Lines per task: weft lines are strided in memory, so several advance together row by row;
+/// warp lines are contiguous and go one by one.
+fn group_size(dir: LineDir) -> usize {
+    match dir {
+        LineDir::Warp => 1,
+        LineDir::Weft => GROUP,
     }
 }
