@@ -47,6 +47,13 @@ impl Sym3f {
         ])
     }
 
+    /// The block in double precision.
+    #[inline]
+    pub fn to_mat3(&self) -> Mat3 {
+        let [a, b, c, d, e, f] = self.0.map(f64::from);
+        Mat3::new(a, b, c, b, d, e, c, e, f)
+    }
+
     /// `self · x`, accumulated in double precision.
     #[inline]
     pub fn mul(&self, x: &Vec3) -> Vec3 {

@@ -113,7 +113,7 @@ impl LineSolver {
                 if slot == NONE || fixed[k] || fixed[k - back] {
                     Mat3::zeros()
                 } else {
-                    a.values[slot]
+                    a.values32[slot].to_mat3()
                 }
             };
             // lines in lockstep groups, so that weft lines walk memory row by row
@@ -143,7 +143,7 @@ impl LineSolver {
                         let mut d = if fixed[k] {
                             Mat3::identity()
                         } else {
-                            a.values[a.diag[k]]
+                            a.values32[a.diag[k]].to_mat3()
                         };
                         // eliminate column k − 2s, then column k − s
                         let l2 = if t >= 2 { a2 * g_2[q] } else { Mat3::zeros() };

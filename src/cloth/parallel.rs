@@ -32,7 +32,7 @@ pub fn ordered_sum(partials: &[f64]) -> f64 {
 
 /// Below this many particles, loops run on the calling thread: handing work to other threads
 /// costs more than it saves.
-pub const PAR_MIN: usize = 3000;
+pub const PAR_MIN: usize = 800;
 
 /// Calls `f(i)` for `i in 0..count`, in parallel when `par`.
 #[inline]
