@@ -5,6 +5,8 @@
 //! [`geometry`] meshes and their files, [`render`] a software rasterizer for pictures.
 //! `script` (feature `scripting`) registers all of it with a Rhai engine.
 #![warn(missing_docs)]
+// hot loops index several flat arrays in step; iterator zips would hide that
+#![allow(clippy::needless_range_loop)]
 
 pub mod bench;
 pub mod cloth;

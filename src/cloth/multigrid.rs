@@ -17,12 +17,6 @@ use crate::geometry::Vec3;
 
 /// Coarsest grid size (particles per side) at which the V-cycle stops coarsening.
 const COARSEST: usize = 6;
-fn coarsest() -> usize {
-    std::env::var("MG_COARSEST")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(COARSEST)
-}
 /// Smoothing sweeps on the coarsest level.
 const COARSE_SWEEPS: usize = 3;
 
@@ -187,7 +181,7 @@ impl Multigrid {
             d: vec![Vec3::zeros(); n],
         }];
         let (mut fx, mut fy) = (nx, ny);
-        while fx.max(fy) > coarsest() && fx.min(fy) >= 4 {
+        while fx.max(fy) > COARSEST && fx.min(fy) >= 4 {
             let (cx, cy) = (fx.div_ceil(2).max(2), fy.div_ceil(2).max(2));
             let cm = ClothModel::grid(w, h, cx, cy, model.fabric)?;
             let mut cm = cm;

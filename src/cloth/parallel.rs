@@ -13,7 +13,10 @@ unsafe impl<T> Sync for SyncPtr<T> {}
 unsafe impl<T> Send for SyncPtr<T> {}
 
 impl<T> SyncPtr<T> {
-    /// Pointer to element `i`. Safety: `i` in bounds, no other thread touches element `i`.
+    /// Pointer to element `i`.
+    ///
+    /// # Safety
+    /// `i` must be in bounds and no other thread may touch element `i` meanwhile.
     #[inline]
     pub unsafe fn at(&self, i: usize) -> *mut T {
         unsafe { self.0.add(i) }

@@ -10,7 +10,7 @@ use super::assembly::{Assembly, AssemblyInputs};
 use super::constraints::{Attachment, ContactHook, Filter, ParticleFilter, Trajectory};
 use super::model::ClothModel;
 use super::multigrid::Multigrid;
-use super::pcg::{PcgWorkspace, Preconditioner};
+use super::pcg::{PcgResult, PcgWorkspace, Preconditioner};
 use super::state::ClothState;
 use super::stats::StepStats;
 use super::ClothError;
@@ -90,7 +90,7 @@ impl SimulationParameters {
         if !(self.cg_tolerance.is_finite() && self.cg_tolerance > 0.0) {
             return Err(bad("cg_tolerance", self.cg_tolerance));
         }
-        if !(self.max_speed > 0.0) {
+        if self.max_speed.is_nan() || self.max_speed <= 0.0 {
             return Err(bad("max_speed", self.max_speed));
         }
         if let Some(g) = self.gravity.iter().find(|g| !g.is_finite()) {
@@ -391,7 +391,7 @@ impl Simulation {
             }
             None => Preconditioner::BlockJacobi(&self.asm.pinv),
         };
-        let res = self.pcg.solve(
+        let mut res = self.pcg.solve(
             &self.asm.a,
             &self.asm.b,
             &mut precond,
@@ -401,6 +401,24 @@ impl Simulation {
             self.params.cg_tolerance,
             self.params.cg_max_iterations,
         );
+        if !res.converged && res.iterations < self.params.cg_max_iterations && self.mg.is_some() {
+            // the multigrid preconditioner broke down (lost definiteness on an extreme
+            // configuration): finish the solve with block-Jacobi from where it stopped
+            let again = self.pcg.solve(
+                &self.asm.a,
+                &self.asm.b,
+                &mut Preconditioner::BlockJacobi(&self.asm.pinv),
+                &self.filter,
+                &self.z,
+                &mut self.dv,
+                self.params.cg_tolerance,
+                self.params.cg_max_iterations - res.iterations,
+            );
+            res = PcgResult {
+                iterations: res.iterations + again.iterations,
+                ..again
+            };
+        }
         let t2 = Instant::now();
         for i in 0..self.particle_count() {
             self.state.v[i] += self.dv[i];
