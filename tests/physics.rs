@@ -452,7 +452,11 @@ fn dropped_cloth_rests_on_the_floor() {
     })
     .unwrap();
     for p in &sim.state.x {
-        assert!((p.z - (height + thickness)).abs() < 1e-6, "resting at z = {}", p.z);
+        assert!(
+            (p.z - (height + thickness)).abs() < 1e-6,
+            "resting at z = {}",
+            p.z
+        );
     }
     let vmax = sim.state.v.iter().map(|v| v.norm()).fold(0.0, f64::max);
     assert!(vmax < 1e-6, "still moving at {vmax} m/s");

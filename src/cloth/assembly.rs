@@ -28,8 +28,11 @@ pub struct Assembly {
     pub a: Bcsr3,
     /// Right-hand side b (or the force, in force-only mode).
     pub b: Vec<Vec3>,
-    /// Inverse diagonal blocks (block-Jacobi preconditioner).
+    /// Inverse diagonal blocks (block-Jacobi preconditioner), formed during assembly when
+    /// `jacobi` is set, or on demand by [`Assembly::form_block_jacobi`].
     pub pinv: Vec<Mat3>,
+    /// Whether assembly forms `pinv` (not needed while multigrid preconditions).
+    pub jacobi: bool,
     blocks: Vec<Mat3>,
     g: Vec<Vec3>,
     recs: Vec<Rec>,
@@ -117,6 +120,7 @@ impl Assembly {
             a,
             b: vec![Vec3::zeros(); n],
             pinv: vec![Mat3::identity(); n],
+            jacobi: true,
             blocks: vec![Mat3::zeros(); ns + nb + 16 * nh],
             g: vec![Vec3::zeros(); 2 * ns + 3 * nb + 4 * nh],
             recs,
@@ -282,6 +286,7 @@ impl Assembly {
         let matrix = inp.matrix;
         let values = SyncPtr(self.a.values.as_mut_ptr());
         let mirror = !self.a.values32.is_empty();
+        let jacobi = self.jacobi;
         let values32 = SyncPtr(self.a.values32.as_mut_ptr());
         let (row_ptr, diag) = (&self.a.row_ptr, &self.a.diag);
         let (recs, rec_ptr, grecs, grec_ptr) =
@@ -319,16 +324,33 @@ impl Assembly {
                                     *values32.at(s) = Sym3f::from_upper(&*values.at(s));
                                 }
                             }
-                            let d = *values.at(diag[i]);
-                            ps[k] = d
-                                .try_inverse()
-                                .unwrap_or_else(|| Mat3::identity() / d.trace().max(1e-300));
+                            if jacobi {
+                                ps[k] = block_inverse(&*values.at(diag[i]));
+                            }
                         }
                     }
                 }
             });
         debug_assert_eq!(self.b.len(), n);
     }
+}
+
+impl Assembly {
+    /// Forms the block-Jacobi preconditioner from the assembled matrix.
+    pub fn form_block_jacobi(&mut self) {
+        let a = &self.a;
+        self.pinv
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(i, p)| *p = block_inverse(&a.values[a.diag[i]]));
+    }
+}
+
+/// Inverse of a diagonal block, or a scaled identity if it is singular.
+#[inline]
+fn block_inverse(d: &Mat3) -> Mat3 {
+    d.try_inverse()
+        .unwrap_or_else(|| Mat3::identity() / d.trace().max(1e-300))
 }
 
 /// Concatenates per-row lists into one array plus row offsets.

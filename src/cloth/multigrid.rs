@@ -188,6 +188,7 @@ impl Multigrid {
             cm.set_law(model.law.clone());
             let mut asm = Assembly::new(&cm);
             asm.a.enable_mirror32();
+            asm.jacobi = false;
             let nc = cx * cy;
             let lines = LineSolver::new(&asm.a, cx, cy);
             levels.last_mut().expect("level").to_fine = None;

@@ -149,6 +149,7 @@ impl Simulation {
         };
         if mg.is_some() {
             asm.a.enable_mirror32();
+            asm.jacobi = false;
         }
         Ok(Simulation {
             state,
@@ -404,6 +405,7 @@ impl Simulation {
         if !res.converged && res.iterations < self.params.cg_max_iterations && self.mg.is_some() {
             // the multigrid preconditioner broke down (lost definiteness on an extreme
             // configuration): finish the solve with block-Jacobi from where it stopped
+            self.asm.form_block_jacobi();
             let again = self.pcg.solve(
                 &self.asm.a,
                 &self.asm.b,
