@@ -188,7 +188,8 @@ impl LineSolver {
 
     /// One block Gauss–Seidel sweep over all lines of `dir`: for each of three colours in
     /// `order`, the residual `r − A e` of that colour's lines is solved exactly on each line
-    /// and added to `e`. Fixed particles keep a zero correction.
+    /// and added to `e`. Fixed particles keep a zero correction. `from_zero` says `e` is zero
+    /// on entry, which spares the first colour's matrix product.
     pub fn sweep(
         &mut self,
         a: &Bcsr3,
@@ -197,6 +198,7 @@ impl LineSolver {
         e: &mut [Vec3],
         fixed: &[bool],
         order: [usize; 3],
+        from_zero: bool,
     ) {
         let (nx, ny) = (self.nx, self.ny);
         let nl = self.line_count(dir);
@@ -207,7 +209,9 @@ impl LineSolver {
         let yp = SyncPtr(self.y.as_mut_ptr());
         let ep = SyncPtr(e.as_mut_ptr());
         let group = group_size(dir);
-        for color in order {
+        for (pass, color) in order.into_iter().enumerate() {
+            // with e = 0 on entry, the first colour's residual is r itself
+            let skip_product = from_zero && pass == 0;
             let count = (nl + 2 - color) / 3;
             for_each_index(count.div_ceil(group), nx * ny >= PAR_MIN, |gi| {
                 let members = gi * group..((gi + 1) * group).min(count);
@@ -222,7 +226,11 @@ impl LineSolver {
                             let mut d = if fixed[k] {
                                 Vec3::zeros()
                             } else {
-                                r[k] - a.row_times32_ptr(k, ep.0)
+                                if skip_product {
+                                    r[k]
+                                } else {
+                                    r[k] - a.row_times32_ptr(k, ep.0)
+                                }
                             };
                             // symmetric elimination: L(k, k−s) = U(k−s, k)ᵀ G(k−s); the
                             // scratch holds w = G y, so the multiplier is never stored

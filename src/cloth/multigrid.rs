@@ -274,11 +274,25 @@ impl Multigrid {
             };
             lv.e.fill(Vec3::zeros());
             // pre-smoothing: warp lines, then weft lines, colours forward
-            for _ in 0..passes {
-                lv.lines
-                    .sweep(a, LineDir::Warp, &lv.r, &mut lv.e, &lv.fixed, FORWARD);
-                lv.lines
-                    .sweep(a, LineDir::Weft, &lv.r, &mut lv.e, &lv.fixed, FORWARD);
+            for p in 0..passes {
+                lv.lines.sweep(
+                    a,
+                    LineDir::Warp,
+                    &lv.r,
+                    &mut lv.e,
+                    &lv.fixed,
+                    FORWARD,
+                    p == 0,
+                );
+                lv.lines.sweep(
+                    a,
+                    LineDir::Weft,
+                    &lv.r,
+                    &mut lv.e,
+                    &lv.fixed,
+                    FORWARD,
+                    false,
+                );
             }
             if !last {
                 residual(a, &lv.r, &lv.e, &mut lv.d, &lv.fixed);
@@ -308,10 +322,24 @@ impl Multigrid {
         };
         // post-smoothing, the adjoint of the pre-smoothing: weft then warp, colours backward
         for _ in 0..passes {
-            lv.lines
-                .sweep(a, LineDir::Weft, &lv.r, &mut lv.e, &lv.fixed, BACKWARD);
-            lv.lines
-                .sweep(a, LineDir::Warp, &lv.r, &mut lv.e, &lv.fixed, BACKWARD);
+            lv.lines.sweep(
+                a,
+                LineDir::Weft,
+                &lv.r,
+                &mut lv.e,
+                &lv.fixed,
+                BACKWARD,
+                false,
+            );
+            lv.lines.sweep(
+                a,
+                LineDir::Warp,
+                &lv.r,
+                &mut lv.e,
+                &lv.fixed,
+                BACKWARD,
+                false,
+            );
         }
     }
 }
