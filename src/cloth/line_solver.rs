@@ -190,6 +190,7 @@ impl LineSolver {
     /// `order`, the residual `r − A e` of that colour's lines is solved exactly on each line
     /// and added to `e`. Fixed particles keep a zero correction. `from_zero` says `e` is zero
     /// on entry, which spares the first colour's matrix product.
+    #[allow(clippy::too_many_arguments)]
     pub fn sweep(
         &mut self,
         a: &Bcsr3,

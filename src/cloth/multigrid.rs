@@ -5,13 +5,11 @@
 //! CG iteration count nearly independent of resolution. Built once per topology; no allocation
 //! per step.
 
-use rayon::prelude::*;
-
 use super::assembly::{Assembly, AssemblyInputs};
-use super::bcsr::{Bcsr3, ROW_CHUNK};
+use super::bcsr::Bcsr3;
 use super::line_solver::{LineDir, LineSolver};
 use super::model::ClothModel;
-use super::parallel::{for_each_index, SyncPtr, PAR_MIN};
+use super::parallel::{for_each_mut, PAR_MIN};
 use super::ClothError;
 use crate::geometry::Vec3;
 
@@ -75,54 +73,41 @@ impl Transfer {
 
     /// fine += P coarse
     fn prolong_add(&self, coarse: &[Vec3], fine: &mut [Vec3], fixed: &[bool]) {
-        let n = fine.len();
-        let fp = SyncPtr(fine.as_mut_ptr());
-        for_each_index(n.div_ceil(ROW_CHUNK), n >= PAR_MIN, |c| {
-            for i in c * ROW_CHUNK..((c + 1) * ROW_CHUNK).min(n) {
-                // SAFETY: each index is written by one task only.
-                let f = unsafe { &mut *fp.at(i) };
-                if !fixed[i] {
-                    let t = &self.taps[i];
-                    *f += coarse[t[0].0 as usize] * t[0].1
-                        + coarse[t[1].0 as usize] * t[1].1
-                        + coarse[t[2].0 as usize] * t[2].1
-                        + coarse[t[3].0 as usize] * t[3].1;
-                }
+        let par = fine.len() >= PAR_MIN;
+        for_each_mut(fine, par, |i, f| {
+            if !fixed[i] {
+                *f += bilinear(&self.taps[i], coarse);
             }
         });
     }
 
     /// coarse = Pᵀ fine (fixed coarse particles get zero)
     fn restrict(&self, fine: &[Vec3], coarse: &mut [Vec3], coarse_fixed: &[bool]) {
-        let n = coarse.len();
-        let cp = SyncPtr(coarse.as_mut_ptr());
-        for_each_index(n.div_ceil(ROW_CHUNK), n >= PAR_MIN, |c| {
-            for i in c * ROW_CHUNK..((c + 1) * ROW_CHUNK).min(n) {
-                // SAFETY: each index is written by one task only.
-                let out = unsafe { &mut *cp.at(i) };
-                let mut acc = Vec3::zeros();
-                if !coarse_fixed[i] {
-                    for &(f, w) in &self.rev[self.rev_ptr[i]..self.rev_ptr[i + 1]] {
-                        acc += fine[f as usize] * w;
-                    }
+        let par = coarse.len() >= PAR_MIN;
+        for_each_mut(coarse, par, |i, out| {
+            *out = Vec3::zeros();
+            if !coarse_fixed[i] {
+                for &(f, w) in &self.rev[self.rev_ptr[i]..self.rev_ptr[i + 1]] {
+                    *out += fine[f as usize] * w;
                 }
-                *out = acc;
             }
         });
     }
+}
 
-    /// coarse state sampled at coarse nodes: least-squares-free pointwise evaluation of the
-    /// fine field at the coarse rest positions (inverse of the bilinear map along each axis).
-    fn sample(&self, fine: &[Vec3], coarse: &mut [Vec3], sample_idx: &[[(u32, f64); 4]]) {
-        coarse.par_iter_mut().enumerate().for_each(|(i, out)| {
-            let t = &sample_idx[i];
-            *out = fine[t[0].0 as usize] * t[0].1
-                + fine[t[1].0 as usize] * t[1].1
-                + fine[t[2].0 as usize] * t[2].1
-                + fine[t[3].0 as usize] * t[3].1;
-        });
-        let _ = self;
-    }
+/// The bilinear combination of `field` at four taps.
+#[inline]
+fn bilinear(t: &[(u32, f64); 4], field: &[Vec3]) -> Vec3 {
+    field[t[0].0 as usize] * t[0].1
+        + field[t[1].0 as usize] * t[1].1
+        + field[t[2].0 as usize] * t[2].1
+        + field[t[3].0 as usize] * t[3].1
+}
+
+/// A coarse level's state sampled from the finer level's field at the coarse rest positions.
+fn sample(fine: &[Vec3], coarse: &mut [Vec3], taps: &[[(u32, f64); 4]]) {
+    let par = coarse.len() >= PAR_MIN;
+    for_each_mut(coarse, par, |i, out| *out = bilinear(&taps[i], fine));
 }
 
 /// One coarse level: its own cloth model and assembly, and scratch vectors.
@@ -238,9 +223,8 @@ impl Multigrid {
             let f = &fine[l - 1];
             let c = &mut coarse[0];
             let (fxs, fvs): (&[Vec3], &[Vec3]) = if l == 1 { (x, v) } else { (&f.x, &f.v) };
-            let t = f.to_fine.as_ref().expect("transfer");
-            t.sample(fxs, &mut c.x, &c.sample);
-            t.sample(fvs, &mut c.v, &c.sample);
+            sample(fxs, &mut c.x, &c.sample);
+            sample(fvs, &mut c.v, &c.sample);
             // a coarse particle is fixed when the fine particle at its rest position is
             for (i, s) in c.sample.iter().enumerate() {
                 c.fixed[i] = s.iter().any(|&(k, w)| w > 0.999_999 && f.fixed[k as usize]);
@@ -349,19 +333,14 @@ const BACKWARD: [usize; 3] = [2, 1, 0];
 
 /// d = r − A e, zero at fixed particles.
 fn residual(a: &Bcsr3, r: &[Vec3], e: &[Vec3], d: &mut [Vec3], fixed: &[bool]) {
-    let n = d.len();
-    let dp = SyncPtr(d.as_mut_ptr());
-    for_each_index(n.div_ceil(ROW_CHUNK), n >= PAR_MIN, |c| {
-        for i in c * ROW_CHUNK..((c + 1) * ROW_CHUNK).min(n) {
-            // SAFETY: each index is written by one task only.
-            let out = unsafe { &mut *dp.at(i) };
-            // SAFETY: e is only read here.
-            *out = if fixed[i] {
-                Vec3::zeros()
-            } else {
-                r[i] - unsafe { a.row_times32_ptr(i, e.as_ptr()) }
-            };
-        }
+    let par = d.len() >= PAR_MIN;
+    for_each_mut(d, par, |i, out| {
+        *out = if fixed[i] {
+            Vec3::zeros()
+        } else {
+            // SAFETY: `e` is a live slice of `a.rows()` vectors that nobody writes meanwhile.
+            r[i] - unsafe { a.row_times32_ptr(i, e.as_ptr()) }
+        };
     });
 }
 

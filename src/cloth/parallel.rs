@@ -47,3 +47,24 @@ pub fn for_each_index<F: Fn(usize) + Sync + Send>(count: usize, par: bool, f: F)
         (0..count).for_each(f);
     }
 }
+
+/// Calls `f(i, &mut items[i])` for every item, over chunks of `CHUNK` in parallel when `par`.
+#[inline]
+pub fn for_each_mut<T: Send, F: Fn(usize, &mut T) + Sync + Send>(items: &mut [T], par: bool, f: F) {
+    use rayon::prelude::*;
+    if par {
+        items
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(c, chunk)| {
+                for (k, item) in chunk.iter_mut().enumerate() {
+                    f(c * CHUNK + k, item);
+                }
+            });
+    } else {
+        items
+            .iter_mut()
+            .enumerate()
+            .for_each(|(i, item)| f(i, item));
+    }
+}
