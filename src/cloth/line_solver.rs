@@ -117,7 +117,7 @@ impl LineSolver {
                 }
             };
             // lines in lockstep groups, so that weft lines walk memory row by row
-            let group = group_size(dir);
+            let group = group_size(dir, nl);
             for_each_index(nl.div_ceil(group), nx * ny >= PAR_MIN, |gi| {
                 let lines = gi * group..((gi + 1) * group).min(nl);
                 let (_, s, len) = Self::line(nx, ny, dir, 0);
@@ -209,11 +209,11 @@ impl LineSolver {
         };
         let yp = SyncPtr(self.y.as_mut_ptr());
         let ep = SyncPtr(e.as_mut_ptr());
-        let group = group_size(dir);
         for (pass, color) in order.into_iter().enumerate() {
             // with e = 0 on entry, the first colour's residual is r itself
             let skip_product = from_zero && pass == 0;
             let count = (nl + 2 - color) / 3;
+            let group = group_size(dir, count);
             for_each_index(count.div_ceil(group), nx * ny >= PAR_MIN, |gi| {
                 let members = gi * group..((gi + 1) * group).min(count);
                 let (_, s, len) = Self::line(nx, ny, dir, 0);
@@ -267,13 +267,17 @@ impl LineSolver {
 }
 
 /// Most lines processed in lockstep by one task.
-const GROUP: usize = 16;
+const GROUP: usize = 128;
 
-/// Lines per task: weft lines are strided in memory, so several advance together row by row;
-/// warp lines are contiguous and go one by one.
-fn group_size(dir: LineDir) -> usize {
+/// Lines per task when `count` lines are to be processed: weft lines are strided in memory, so
+/// as many as possible advance together row by row (one group per thread, which turns the
+/// accesses into sequential streams); warp lines are contiguous and go one by one. Grouping
+/// changes no arithmetic, so results do not depend on the thread count.
+fn group_size(dir: LineDir, count: usize) -> usize {
     match dir {
         LineDir::Warp => 1,
-        LineDir::Weft => GROUP,
+        LineDir::Weft => count
+            .div_ceil(rayon::current_num_threads())
+            .clamp(1, GROUP),
     }
 }
