@@ -11,6 +11,7 @@
 pub mod bench;
 pub mod cloth;
 pub mod geometry;
+pub mod kes;
 pub mod render;
 pub mod scenes;
 #[cfg(feature = "scripting")]
