@@ -9,6 +9,8 @@
 use rayon::prelude::*;
 
 use super::bcsr::{Bcsr3, Sym3f};
+use super::elements::{bend_friction, SpringKind};
+use super::material::Direction;
 use super::model::ClothModel;
 use super::parallel::{chunks, ordered_sum, SyncPtr, CHUNK};
 use crate::geometry::{Mat3, Vec3};
@@ -39,11 +41,19 @@ pub struct Assembly {
     rec_ptr: Vec<usize>,
     grecs: Vec<u32>,
     grec_ptr: Vec<usize>,
+    quad_block0: usize,
     bend_block0: usize,
     hinge_block0: usize,
+    quad_g0: usize,
     bend_g0: usize,
     hinge_g0: usize,
     energy_partials: Vec<f64>,
+    /// Friction states (committed coordinate, friction force) per element, allocated on the
+    /// first assembly with a law that has internal friction; NaN coordinate = not yet seen.
+    fric_spring: Vec<[f64; 2]>,
+    fric_quad: Vec<[f64; 2]>,
+    fric_bend: Vec<[Vec3; 2]>,
+    fric_hinge: Vec<[f64; 2]>,
 }
 
 /// What to assemble.
@@ -63,12 +73,15 @@ impl Assembly {
         let n = model.particle_count();
         let a = Bcsr3::with_pattern(n, &model.coupled_pairs());
         let ns = model.springs.len();
+        let nq = model.shear_quads.len();
         let nb = model.bend_lines.len();
         let nh = model.hinges.len();
-        let bend_block0 = ns;
-        let hinge_block0 = ns + nb;
-        let bend_g0 = 2 * ns;
-        let hinge_g0 = 2 * ns + 3 * nb;
+        let quad_block0 = ns;
+        let bend_block0 = ns + 2 * nq;
+        let hinge_block0 = bend_block0 + nb;
+        let quad_g0 = 2 * ns;
+        let bend_g0 = quad_g0 + 4 * nq;
+        let hinge_g0 = bend_g0 + 3 * nb;
         let mut rows: Vec<Vec<Rec>> = vec![Vec::new(); n];
         let mut grows: Vec<Vec<u32>> = vec![Vec::new(); n];
         let slot = |i: usize, j: usize| a.slot(i, j).expect("pair in pattern") as u32;
@@ -85,6 +98,25 @@ impl Assembly {
                     scale: -1.0,
                 });
                 grows[me].push(gi as u32);
+            }
+        }
+        for (q, quad) in model.shear_quads.iter().enumerate() {
+            for k in 0..2 {
+                let (a, b) = (quad.nodes[2 * k], quad.nodes[2 * k + 1]);
+                let src = (quad_block0 + 2 * q + k) as u32;
+                for (me, other, gi) in [(a, b, 4 * q + 2 * k), (b, a, 4 * q + 2 * k + 1)] {
+                    rows[me].push(Rec {
+                        slot: slot(me, me),
+                        src,
+                        scale: 1.0,
+                    });
+                    rows[me].push(Rec {
+                        slot: slot(me, other),
+                        src,
+                        scale: -1.0,
+                    });
+                    grows[me].push((quad_g0 + gi) as u32);
+                }
             }
         }
         for (e, bl) in model.bend_lines.iter().enumerate() {
@@ -115,23 +147,29 @@ impl Assembly {
         }
         let (recs, rec_ptr) = flatten(rows);
         let (grecs, grec_ptr) = flatten(grows);
-        let n_elems = ns + nb + nh;
+        let n_elems = ns + nq + nb + nh;
         Assembly {
             a,
             b: vec![Vec3::zeros(); n],
             pinv: vec![Mat3::identity(); n],
             jacobi: true,
-            blocks: vec![Mat3::zeros(); ns + nb + 16 * nh],
-            g: vec![Vec3::zeros(); 2 * ns + 3 * nb + 4 * nh],
+            blocks: vec![Mat3::zeros(); ns + 2 * nq + nb + 16 * nh],
+            g: vec![Vec3::zeros(); 2 * ns + 4 * nq + 3 * nb + 4 * nh],
             recs,
             rec_ptr,
             grecs,
             grec_ptr,
+            quad_block0,
             bend_block0,
             hinge_block0,
+            quad_g0,
             bend_g0,
             hinge_g0,
-            energy_partials: vec![0.0; chunks(n_elems.max(1), CHUNK) + 3],
+            energy_partials: vec![0.0; chunks(n_elems.max(1), CHUNK) + 4],
+            fric_spring: Vec::new(),
+            fric_quad: Vec::new(),
+            fric_bend: Vec::new(),
+            fric_hinge: Vec::new(),
         }
     }
 
@@ -145,6 +183,13 @@ impl Assembly {
         v: &[Vec3],
         inp: AssemblyInputs,
     ) -> f64 {
+        if model.law.has_friction() && self.fric_spring.len() != model.springs.len() {
+            // once per topology: friction states start unseen (taken at the first evaluation)
+            self.fric_spring = vec![[f64::NAN, 0.0]; model.springs.len()];
+            self.fric_quad = vec![[f64::NAN, 0.0]; model.shear_quads.len()];
+            self.fric_bend = vec![[Vec3::repeat(f64::NAN), Vec3::zeros()]; model.bend_lines.len()];
+            self.fric_hinge = vec![[f64::NAN, 0.0]; model.hinges.len()];
+        }
         let energy = self.element_pass(model, x, v, inp);
         self.gather_pass(model, v, inp);
         energy
@@ -167,16 +212,31 @@ impl Assembly {
         };
         let (beta_s, beta_b) = (fab.stretch_damping, fab.bend_damping);
         let ns = model.springs.len();
+        let nq = model.shear_quads.len();
         let nb = model.bend_lines.len();
         let nsc = chunks(ns, CHUNK);
+        let nqc = chunks(nq, CHUNK);
         let nbc = chunks(nb, CHUNK);
-        let (blocks_s, rest) = self.blocks.split_at_mut(self.bend_block0);
+        let (blocks_s, rest) = self.blocks.split_at_mut(self.quad_block0);
+        let (blocks_q, rest) = rest.split_at_mut(self.bend_block0 - self.quad_block0);
         let (blocks_b, blocks_h) = rest.split_at_mut(self.hinge_block0 - self.bend_block0);
-        let (g_s, rest) = self.g.split_at_mut(self.bend_g0);
+        let (g_s, rest) = self.g.split_at_mut(self.quad_g0);
+        let (g_q, rest) = rest.split_at_mut(self.bend_g0 - self.quad_g0);
         let (g_b, g_h) = rest.split_at_mut(self.hinge_g0 - self.bend_g0);
         let (ep_s, rest) = self.energy_partials.split_at_mut(nsc);
+        let (ep_q, rest) = rest.split_at_mut(nqc);
         let (ep_b, ep_h) = rest.split_at_mut(nbc);
         let matrix = inp.matrix;
+        let friction = !self.fric_spring.is_empty();
+        let fr_warp = law.tension_friction(Direction::Warp).filter(|_| friction);
+        let fr_weft = law.tension_friction(Direction::Weft).filter(|_| friction);
+        let fr_shear = law.shear_friction().filter(|_| friction);
+        let fr_bend_u = law.bending_friction(Direction::Warp).filter(|_| friction);
+        let fr_bend_v = law.bending_friction(Direction::Weft).filter(|_| friction);
+        let st_s = SyncPtr(self.fric_spring.as_mut_ptr());
+        let st_q = SyncPtr(self.fric_quad.as_mut_ptr());
+        let st_b = SyncPtr(self.fric_bend.as_mut_ptr());
+        let st_h = SyncPtr(self.fric_hinge.as_mut_ptr());
         // springs
         model
             .springs
@@ -184,23 +244,83 @@ impl Assembly {
             .zip(blocks_s.par_chunks_mut(CHUNK))
             .zip(g_s.par_chunks_mut(2 * CHUNK))
             .zip(ep_s.par_iter_mut())
-            .for_each(|(((sp, bl), g), ep)| {
+            .enumerate()
+            .for_each(|(c, (((sp, bl), g), ep))| {
                 let mut e = 0.0;
                 for k in 0..sp.len() {
                     let s = &sp[k];
-                    let ev = s.eval(law, &x[s.a], &x[s.b]);
+                    let mut ev = s.eval(law, &x[s.a], &x[s.b]);
                     e += ev.energy;
+                    let fr = match s.kind {
+                        SpringKind::Stretch { warp_weight } if warp_weight >= 0.5 => fr_warp,
+                        SpringKind::Stretch { .. } => fr_weft,
+                        SpringKind::Shear => fr_shear,
+                    };
+                    let axial_el = ev.axial;
+                    if let Some(f) = fr {
+                        // SAFETY: element c·CHUNK + k is visited by this iteration only.
+                        let st = unsafe { &mut *st_s.at(c * CHUNK + k) };
+                        s.add_friction(&f, st, &x[s.a], &x[s.b], &mut ev);
+                    }
                     let rel = v[s.b] - v[s.a];
-                    let damp = beta_s * ev.axial * ev.dir.dot(&rel);
+                    let damp = beta_s * axial_el * ev.dir.dot(&rel);
                     let mut ga = ev.dir * ((ev.tension + damp) * hf);
                     if matrix {
                         let kmat = ev.stiffness();
                         ga += kmat * rel * hk;
-                        let c = ev.dir * ev.dir.transpose() * (beta_s * ev.axial);
+                        let c = ev.dir * ev.dir.transpose() * (beta_s * axial_el);
                         bl[k] = kmat * hk + c * inp.dt;
                     }
                     g[2 * k] = ga;
                     g[2 * k + 1] = -ga;
+                }
+                *ep = e;
+            });
+        // shear cells: two spring-like diagonals each
+        model
+            .shear_quads
+            .par_chunks(CHUNK)
+            .zip(blocks_q.par_chunks_mut(2 * CHUNK))
+            .zip(g_q.par_chunks_mut(4 * CHUNK))
+            .zip(ep_q.par_iter_mut())
+            .enumerate()
+            .for_each(|(c, (((qs, bl), g), ep))| {
+                let mut e = 0.0;
+                for k in 0..qs.len() {
+                    let q = &qs[k];
+                    let (d1, d2, gamma) = q.measure(x);
+                    let (mut hs, mut dhs, w) = law.shear(gamma);
+                    let dhs_el = dhs;
+                    if let Some(f) = fr_shear {
+                        // SAFETY: element c·CHUNK + k is visited by this iteration only.
+                        let st = unsafe { &mut *st_q.at(c * CHUNK + k) };
+                        if st[0].is_nan() {
+                            *st = [gamma, 0.0];
+                        }
+                        let (z, dz) = f.update(st[0], st[1], gamma, hs, dhs);
+                        *st = [gamma, z];
+                        hs += z;
+                        dhs += dz;
+                    }
+                    e += q.area * w;
+                    let g2 = 2.0 * q.inv;
+                    for (m, (d, sign)) in [(d1, 1.0), (d2, -1.0)].into_iter().enumerate() {
+                        let (a, b) = (q.nodes[2 * m], q.nodes[2 * m + 1]);
+                        let rel = v[b] - v[a];
+                        let ddt = d * d.transpose();
+                        let axial = ddt * (2.0 * q.area * g2 * g2);
+                        let cdamp = axial * (beta_s * dhs_el);
+                        // force on the diagonal's first node (the second gets the opposite)
+                        let mut ga = d * (sign * q.area * hs * g2 * hf) + cdamp * rel * hf;
+                        if matrix {
+                            let kmat = axial * dhs.max(0.0)
+                                + Mat3::identity() * (sign * q.area * hs * g2).max(0.0);
+                            ga += kmat * rel * hk;
+                            bl[2 * k + m] = kmat * hk + cdamp * inp.dt;
+                        }
+                        g[4 * k + 2 * m] = ga;
+                        g[4 * k + 2 * m + 1] = -ga;
+                    }
                 }
                 *ep = e;
             });
@@ -211,22 +331,42 @@ impl Assembly {
             .zip(blocks_b.par_chunks_mut(CHUNK))
             .zip(g_b.par_chunks_mut(3 * CHUNK))
             .zip(ep_b.par_iter_mut())
-            .for_each(|(((els, bl), g), ep)| {
+            .enumerate()
+            .for_each(|(c, (((els, bl), g), ep))| {
                 let mut e = 0.0;
                 for k in 0..els.len() {
                     let el = &els[k];
-                    let (gen, s, en) = el.eval(law, x);
+                    let (mut gen, mut s, en) = el.eval(law, x);
+                    let s_el = s;
+                    let fr = match el.dir {
+                        Direction::Warp => fr_bend_u,
+                        Direction::Weft => fr_bend_v,
+                    };
+                    if let Some(f) = fr {
+                        // SAFETY: element c·CHUNK + k is visited by this iteration only.
+                        let st = unsafe { &mut *st_b.at(c * CHUNK + k) };
+                        let q = el.curvature(x);
+                        if st[0].x.is_nan() {
+                            *st = [q, Vec3::zeros()];
+                        }
+                        let m_el = law.bending(el.dir, q.norm()).0;
+                        let (z, t) = bend_friction(&f, &st[0], &st[1], &q, m_el);
+                        *st = [q, z];
+                        gen += z * el.area;
+                        s += t * el.area;
+                    }
                     e += en;
-                    let [a, b, c] = el.nodes;
-                    let w = v[a] * el.coef[0] + v[b] * el.coef[1] + v[c] * el.coef[2];
+                    let [a, b, cc] = el.nodes;
+                    let w = v[a] * el.coef[0] + v[b] * el.coef[1] + v[cc] * el.coef[2];
                     let sw = s * w;
-                    // f_m = −c_m (gen + β S w);  K v contribution c_m S w
+                    let dw = s_el * w * beta_b;
+                    // f_m = −c_m (gen + β S_el w);  K v contribution c_m S w
                     for m in 0..3 {
                         let cm = el.coef[m];
-                        g[3 * k + m] = -(gen + sw * beta_b) * (cm * hf) - sw * (cm * hk);
+                        g[3 * k + m] = -(gen + dw) * (cm * hf) - sw * (cm * hk);
                     }
                     if matrix {
-                        bl[k] = s * (hk + inp.dt * beta_b);
+                        bl[k] = s * hk + s_el * (inp.dt * beta_b);
                     }
                 }
                 *ep = e;
@@ -241,7 +381,8 @@ impl Assembly {
                 .zip(blocks_h.par_chunks_mut(16 * CHUNK))
                 .zip(g_h.par_chunks_mut(4 * CHUNK))
                 .zip(ep_h.par_iter_mut())
-                .for_each(|(((els, bl), g), ep)| {
+                .enumerate()
+                .for_each(|(c, (((els, bl), g), ep))| {
                     let mut e = 0.0;
                     for k in 0..els.len() {
                         let el = &els[k];
@@ -257,17 +398,37 @@ impl Assembly {
                         let kappa = theta.abs() * el.edge / el.area;
                         let (mo, dm, w) = el.law(law, kappa);
                         e += el.area * w;
-                        let dedtheta = el.edge * mo * theta.signum();
-                        let stiff = dm * el.edge * el.edge / el.area;
+                        // signed moment per width and its tangent in signed curvature
+                        let (mut ms, mut dms) = (mo * theta.signum(), dm);
+                        let fr = if el.warp_weight >= 0.5 {
+                            fr_bend_u
+                        } else {
+                            fr_bend_v
+                        };
+                        if let Some(f) = fr {
+                            // SAFETY: element c·CHUNK + k is visited by this iteration only.
+                            let st = unsafe { &mut *st_h.at(c * CHUNK + k) };
+                            let ks = theta * el.edge / el.area;
+                            if st[0].is_nan() {
+                                *st = [ks, 0.0];
+                            }
+                            let (z, dz) = f.update(st[0], st[1], ks, ms, dms);
+                            *st = [ks, z];
+                            ms += z;
+                            dms += dz;
+                        }
+                        let dedtheta = el.edge * ms;
+                        let stiff_el = dm * el.edge * el.edge / el.area;
+                        let stiff = dms.max(0.0) * el.edge * el.edge / el.area;
                         let gv: f64 = (0..4).map(|m| grad[m].dot(&v[el.nodes[m]])).sum();
                         for m in 0..4 {
-                            g[4 * k + m] =
-                                -grad[m] * (dedtheta * hf + stiff * gv * (beta_b * hf + hk));
+                            g[4 * k + m] = -grad[m]
+                                * (dedtheta * hf + stiff_el * gv * beta_b * hf + stiff * gv * hk);
                             if matrix {
                                 for q in 0..4 {
                                     bl[16 * k + 4 * m + q] = grad[m]
                                         * grad[q].transpose()
-                                        * (stiff * (hk + inp.dt * beta_b));
+                                        * (stiff * hk + stiff_el * inp.dt * beta_b);
                                 }
                             }
                         }
@@ -276,7 +437,10 @@ impl Assembly {
                 });
             ordered_sum(&ep_h[..chunks(model.hinges.len(), CHUNK)])
         };
-        ordered_sum(&ep_s[..nsc]) + ordered_sum(&ep_b[..nbc]) + hinge_e
+        ordered_sum(&ep_s[..nsc])
+            + ordered_sum(&ep_q[..nqc])
+            + ordered_sum(&ep_b[..nbc])
+            + hinge_e
     }
 
     fn gather_pass(&mut self, model: &ClothModel, v: &[Vec3], inp: AssemblyInputs) {

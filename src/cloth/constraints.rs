@@ -103,6 +103,14 @@ pub enum ParticleFilter {
         /// Position at the end of the step.
         target: Vec3,
     },
+    /// Free only along unit `free` (S = f fᵀ); in the two other directions the particle goes
+    /// to `target` at the end of the step (a clamp that slides along one axis).
+    Axis {
+        /// The free unit direction.
+        free: Vec3,
+        /// Position at the end of the step in the constrained directions.
+        target: Vec3,
+    },
     /// Velocity along unit `normal` prescribed (contact): S = I − n nᵀ.
     Normal {
         /// Constrained unit direction.
@@ -140,7 +148,7 @@ impl Filter {
     /// particle is already fully fixed. A second normal on the same particle fixes the
     /// particle's velocity along both (approximated by keeping the newer normal).
     pub fn constrain_normal(&mut self, i: usize, normal: Vec3, velocity: f64) {
-        if !matches!(self.kind[i], ParticleFilter::Fixed { .. }) {
+        if matches!(self.kind[i], ParticleFilter::Free | ParticleFilter::Normal { .. }) {
             self.kind[i] = ParticleFilter::Normal { normal, velocity };
             self.any = true;
         }
@@ -152,6 +160,7 @@ impl Filter {
         match self.kind[i] {
             ParticleFilter::Free => a,
             ParticleFilter::Fixed { .. } => Vec3::zeros(),
+            ParticleFilter::Axis { free, .. } => free * free.dot(&a),
             ParticleFilter::Normal { normal, .. } => a - normal * normal.dot(&a),
         }
     }
@@ -163,6 +172,10 @@ impl Filter {
         match self.kind[i] {
             ParticleFilter::Free => Vec3::zeros(),
             ParticleFilter::Fixed { target } => (target - x) / dt - v,
+            ParticleFilter::Axis { free, target } => {
+                let w = (target - x) / dt - v;
+                w - free * free.dot(&w)
+            }
             ParticleFilter::Normal { normal, velocity } => normal * (velocity - normal.dot(v)),
         }
     }

@@ -3,7 +3,7 @@
 //! triangles sharing an edge, for any triangle mesh). Each element evaluates its energy,
 //! forces and stiffness blocks from a `MaterialLaw`.
 
-use super::material::{Direction, MaterialLaw};
+use super::material::{Direction, Friction, MaterialLaw};
 use crate::geometry::{Mat3, Vec3};
 
 /// What a spring resists.
@@ -95,6 +95,43 @@ impl Spring {
     }
 }
 
+impl Spring {
+    /// Adds internal friction to an evaluation `ev` of this spring at (`xa`, `xb`), updating
+    /// and committing the friction state `st` = (coordinate, friction force per width). The
+    /// coordinate is the strain for stretch springs and the shear angle 2ε for shear springs.
+    #[inline]
+    pub fn add_friction(
+        &self,
+        f: &Friction,
+        st: &mut [f64; 2],
+        xa: &Vec3,
+        xb: &Vec3,
+        ev: &mut SpringEval,
+    ) {
+        let len = (xb - xa).norm();
+        let gain = match self.kind {
+            SpringKind::Stretch { .. } => 1.0,
+            SpringKind::Shear => 2.0,
+        };
+        let coord = gain * (len / self.rest - 1.0);
+        if st[0].is_nan() {
+            *st = [coord, 0.0];
+        }
+        // elastic force per width and tangent in the mode's own coordinate
+        let f_el = ev.tension * self.rest / self.area / gain;
+        let df_el = ev.axial * self.rest * self.rest / self.area / (gain * gain);
+        let (z, dz) = f.update(st[0], st[1], coord, f_el, df_el);
+        *st = [coord, z];
+        ev.tension += self.area * z * gain / self.rest;
+        ev.axial += self.area * dz * gain * gain / (self.rest * self.rest);
+        ev.transverse = if len > 0.0 {
+            (ev.tension / len).max(0.0)
+        } else {
+            0.0
+        };
+    }
+}
+
 impl SpringEval {
     /// Stiffness block K = −∂f_a/∂x_a (symmetric, positive semi-definite).
     #[inline]
@@ -131,6 +168,13 @@ impl BendLine {
         }
     }
 
+    /// The curvature vector q = Σ c_m x_m (1/m).
+    #[inline]
+    pub fn curvature(&self, x: &[Vec3]) -> Vec3 {
+        let [a, b, c] = self.nodes;
+        x[a] * self.coef[0] + x[b] * self.coef[1] + x[c] * self.coef[2]
+    }
+
     /// Evaluates: (curvature vector q, M(κ), dM/dκ, energy). The force on node m is
     /// `−area · M · c_m · q̂` and the stiffness block (m, n) is `c_m c_n · S` with
     /// `S = area · (M' q̂q̂ᵀ + M/κ (I − q̂q̂ᵀ))`.
@@ -154,6 +198,55 @@ impl BendLine {
         let s = (qqt * (dm - ratio) + Mat3::identity() * ratio) * self.area;
         // generalised force vector: area · M · q̂  (node m gets −c_m times it)
         (qh * (self.area * m), s, self.area * w)
+    }
+}
+
+/// Shear of one grid cell, measured by its two diagonals: with d1 = x₁ − x₀ and d2 = x₃ − x₂
+/// the diagonals of a cell of rest sides a × b, `γ = (|d1|² − |d2|²) / (4ab)` (= u·v/(ab), the
+/// sine of the shear angle for unstretched sides). Energy `area · W(γ)`. Pure stretch leaves
+/// γ = 0, so tensile tests see no shear stiffness (unlike independent diagonal springs).
+///
+/// Its stiffness is approximated per diagonal, spring-like (symmetric 3×3 blocks, as the
+/// multigrid smoother needs): `2·area·W''·g_k g_kᵀ` plus the positive part of the
+/// `area·W'·∂²γ` term, with g_k = 2 d_k/(4ab). This is exact for pure shear and over-stiff
+/// (by a shear-sized amount) only for dilation, which keeps the implicit step stable.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShearQuad {
+    /// Diagonal 1 (from, to) then diagonal 2 (from, to).
+    pub nodes: [usize; 4],
+    /// 1/(4ab) (1/m²).
+    pub inv: f64,
+    /// Rest area ab of fabric the element stands for (m²).
+    pub area: f64,
+}
+
+impl ShearQuad {
+    /// The diagonals d1, d2 and γ at positions `x`.
+    #[inline]
+    pub fn measure(&self, x: &[Vec3]) -> (Vec3, Vec3, f64) {
+        let [a1, b1, a2, b2] = self.nodes;
+        let d1 = x[b1] - x[a1];
+        let d2 = x[b2] - x[a2];
+        (d1, d2, (d1.norm_squared() - d2.norm_squared()) * self.inv)
+    }
+}
+
+/// Vector Jenkins friction of a bending line: the friction moment z (a vector in curvature
+/// space) sticks with stiffness `stick` and slides on the sphere |z| = threshold. Returns the
+/// friction moment per width and its (symmetric) tangent. `qc`, `zc`: committed state.
+#[inline]
+pub fn bend_friction(f: &Friction, qc: &Vec3, zc: &Vec3, q: &Vec3, m_el: f64) -> (Vec3, Mat3) {
+    let trial = zc + (q - qc) * f.stick;
+    let t = f.threshold(m_el);
+    let n = trial.norm();
+    if n <= t {
+        (trial, Mat3::identity() * f.stick)
+    } else {
+        let zh = trial / n;
+        (
+            zh * t,
+            (Mat3::identity() - zh * zh.transpose()) * (f.stick * t / n),
+        )
     }
 }
 

@@ -23,6 +23,68 @@ pub trait MaterialLaw: Send + Sync + std::fmt::Debug {
     /// Bending moment per unit width at curvature `kappa` ≥ 0 (1/m) bending about an axis
     /// perpendicular to `dir`: (M, dM/dκ, energy per unit area).
     fn bending(&self, dir: Direction, kappa: f64) -> (f64, f64, f64);
+    /// Internal friction of tension along `dir` (strain as the coordinate, force per width).
+    fn tension_friction(&self, _dir: Direction) -> Option<Friction> {
+        None
+    }
+    /// Internal friction of shear (shear angle in rad, force per width).
+    fn shear_friction(&self) -> Option<Friction> {
+        None
+    }
+    /// Internal friction of bending about an axis perpendicular to `dir` (curvature in 1/m,
+    /// moment per width).
+    fn bending_friction(&self, _dir: Direction) -> Option<Friction> {
+        None
+    }
+    /// True when any mode has internal friction (elements then keep a friction state).
+    fn has_friction(&self) -> bool {
+        self.tension_friction(Direction::Warp).is_some()
+            || self.tension_friction(Direction::Weft).is_some()
+            || self.shear_friction().is_some()
+            || self.bending_friction(Direction::Warp).is_some()
+            || self.bending_friction(Direction::Weft).is_some()
+    }
+}
+
+/// Rate-independent internal friction of one deformation mode: a Jenkins element (a stick
+/// spring of stiffness `stick` in series with a slider) in parallel with the elastic law. The
+/// slider's threshold grows with the elastic force, `base + slope · |F_el|` (yarn contact
+/// pressure rises with load), which reproduces Kawabata loops whose width grows with
+/// amplitude (2HG5 > 2HG) and tensile recovery below 100 % (RT).
+///
+/// State per element: the coordinate `x_c` and friction force `z_c` at the last evaluation.
+/// An evaluation at `x` gives `z = clamp(z_c + stick (x − x_c), ±threshold)` and is then
+/// committed; evaluating twice at the same `x` changes nothing.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Friction {
+    /// Stiffness while sticking (force per width per unit of the coordinate).
+    pub stick: f64,
+    /// Slider threshold at zero elastic force (force per width).
+    pub base: f64,
+    /// Threshold growth per unit elastic force (dimensionless).
+    pub slope: f64,
+}
+
+impl Friction {
+    /// Slider threshold when the elastic force is `f_el`.
+    #[inline]
+    pub fn threshold(&self, f_el: f64) -> f64 {
+        self.base + self.slope * f_el.abs()
+    }
+
+    /// Friction force and its tangent dz/dx at coordinate `x`, from the committed state
+    /// (`xc`, `zc`), with elastic force `f_el` and elastic tangent `df_el` at `x`.
+    #[inline]
+    pub fn update(&self, xc: f64, zc: f64, x: f64, f_el: f64, df_el: f64) -> (f64, f64) {
+        let trial = zc + self.stick * (x - xc);
+        let t = self.threshold(f_el);
+        if trial.abs() <= t {
+            (trial, self.stick)
+        } else {
+            let s = trial.signum();
+            (s * t, s * self.slope * f_el.signum() * df_el)
+        }
+    }
 }
 
 /// Linear elastic fabric: constant tensile, shear and bending rigidities.

@@ -9,6 +9,7 @@ pub mod elements;
 pub mod error;
 pub mod line_solver;
 pub mod material;
+pub mod measured;
 pub mod model;
 pub mod multigrid;
 pub mod parallel;
@@ -19,7 +20,8 @@ pub mod stats;
 
 pub use constraints::{Attachment, ContactHook, Filter, Floor, Trajectory};
 pub use error::ClothError;
-pub use material::{Direction, FabricParameters, LinearMaterial, MaterialLaw};
+pub use material::{Direction, FabricParameters, Friction, LinearMaterial, MaterialLaw};
+pub use measured::{MeasuredLaw, ResponseCurve};
 pub use model::ClothModel;
 pub use simulation::{Integrator, PreconditionerKind, Simulation, SimulationParameters};
 pub use state::ClothState;

@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use super::elements::{BendLine, Hinge, Spring, SpringKind};
+use super::elements::{BendLine, Hinge, ShearQuad, Spring, SpringKind};
 use super::material::{Direction, FabricParameters, MaterialLaw};
 use super::ClothError;
 use crate::geometry::{grid_mesh, Topology, TriMesh};
@@ -20,6 +20,8 @@ pub struct ClothModel {
     pub area: Vec<f64>,
     /// Stretch and shear springs.
     pub springs: Vec<Spring>,
+    /// Shear elements of grid cells.
+    pub shear_quads: Vec<ShearQuad>,
     /// Grid-line bending elements.
     pub bend_lines: Vec<BendLine>,
     /// Dihedral bending hinges.
@@ -34,8 +36,8 @@ pub struct ClothModel {
 
 impl ClothModel {
     /// A `width` × `height` rectangle of `nx` × `ny` particles, flat in the XY plane at z = 0
-    /// (see [`grid_mesh`]), with warp springs along x, weft springs along y, two shear
-    /// diagonals per quad and bending lines along both directions.
+    /// (see [`grid_mesh`]), with warp springs along x, weft springs along y, a shear element
+    /// per cell (measured through its diagonals) and bending lines along both directions.
     pub fn grid(
         width: f64,
         height: f64,
@@ -52,9 +54,9 @@ impl ClothModel {
         let wx = |j: usize| if j == 0 || j == nx - 1 { 0.5 * dx } else { dx };
         let mut springs = Vec::new();
         let mut bend_lines = Vec::new();
+        let mut shear_quads = Vec::new();
         let warp = SpringKind::Stretch { warp_weight: 1.0 };
         let weft = SpringKind::Stretch { warp_weight: 0.0 };
-        let diag = (dx * dx + dy * dy).sqrt();
         for i in 0..ny {
             for j in 0..nx {
                 if j + 1 < nx {
@@ -76,20 +78,10 @@ impl ClothModel {
                     });
                 }
                 if i + 1 < ny && j + 1 < nx {
-                    let area = 0.25 * diag * diag;
-                    springs.push(Spring {
-                        a: id(i, j),
-                        b: id(i + 1, j + 1),
-                        rest: diag,
-                        area,
-                        kind: SpringKind::Shear,
-                    });
-                    springs.push(Spring {
-                        a: id(i, j + 1),
-                        b: id(i + 1, j),
-                        rest: diag,
-                        area,
-                        kind: SpringKind::Shear,
+                    shear_quads.push(ShearQuad {
+                        nodes: [id(i, j), id(i + 1, j + 1), id(i, j + 1), id(i + 1, j)],
+                        inv: 1.0 / (4.0 * dx * dy),
+                        area: dx * dy,
                     });
                 }
                 if j >= 1 && j + 1 < nx {
@@ -119,6 +111,7 @@ impl ClothModel {
             mass,
             area,
             springs,
+            shear_quads,
             bend_lines,
             hinges: Vec::new(),
             law: Arc::new(fabric.linear_law()),
@@ -206,6 +199,7 @@ impl ClothModel {
             mass,
             area,
             springs,
+            shear_quads: Vec::new(),
             bend_lines: Vec::new(),
             hinges,
             law: Arc::new(fabric.linear_law()),
@@ -229,6 +223,9 @@ impl ClothModel {
         let mut pairs = Vec::new();
         for s in &self.springs {
             pairs.push((s.a, s.b));
+        }
+        for q in &self.shear_quads {
+            pairs.extend([(q.nodes[0], q.nodes[1]), (q.nodes[2], q.nodes[3])]);
         }
         for e in &self.bend_lines {
             let [a, b, c] = e.nodes;
