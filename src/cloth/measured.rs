@@ -53,8 +53,13 @@ impl ResponseCurve {
             .map(|k| (ys[k + 1] - ys[k]) / (xs[k + 1] - xs[k]))
             .collect();
         let mut ds = vec![0.0; n];
-        ds[0] = sec[0];
-        ds[n - 1] = sec[n - 2];
+        ds[0] = end_slope(xs[1] - xs[0], xs.get(2).map(|x| x - xs[1]), sec[0], sec.get(1));
+        ds[n - 1] = end_slope(
+            xs[n - 1] - xs[n - 2],
+            (n > 2).then(|| xs[n - 2] - xs[n - 3]),
+            sec[n - 2],
+            (n > 2).then(|| &sec[n - 3]),
+        );
         for k in 1..n - 1 {
             let (a, b) = (sec[k - 1], sec[k]);
             ds[k] = if a * b <= 0.0 {
@@ -123,6 +128,22 @@ impl ResponseCurve {
     pub fn end(&self) -> [f64; 2] {
         let n = self.xs.len();
         [self.xs[n - 1], self.ys[n - 1]]
+    }
+}
+
+/// The shape-preserving three-point end derivative of PCHIP (Moler, *Numerical Computing
+/// with MATLAB*): h0, δ0 the end interval and its secant, h1, δ1 the next ones.
+fn end_slope(h0: f64, h1: Option<f64>, d0: f64, d1: Option<&f64>) -> f64 {
+    let (Some(h1), Some(&d1)) = (h1, d1) else {
+        return d0;
+    };
+    let d = ((2.0 * h0 + h1) * d0 - h0 * d1) / (h0 + h1);
+    if d * d0 <= 0.0 {
+        0.0
+    } else if d0 * d1 < 0.0 && d.abs() > 3.0 * d0.abs() {
+        3.0 * d0
+    } else {
+        d
     }
 }
 
