@@ -9,7 +9,7 @@
 use rayon::prelude::*;
 
 use super::bcsr::{Bcsr3, Sym3f};
-use super::elements::{bend_friction, SpringKind};
+use super::elements::{bend_friction, BendLine, SpringKind};
 use super::material::Direction;
 use super::model::ClothModel;
 use super::parallel::{chunks, ordered_sum, SyncPtr, CHUNK};
@@ -336,8 +336,12 @@ impl Assembly {
                 let mut e = 0.0;
                 for k in 0..els.len() {
                     let el = &els[k];
-                    let (mut gen, mut s, en) = el.eval(law, x);
-                    let s_el = s;
+                    let geo = el.geometry(x);
+                    let kappa = geo.qn.norm();
+                    let (m_el, dm, en) = law.bending(el.dir, kappa);
+                    let (mut mv, mut s) = BendLine::elastic(&geo, m_el, dm);
+                    let f2 = el.area * geo.scale * geo.scale;
+                    let s_el = s * f2;
                     let fr = match el.dir {
                         Direction::Warp => fr_bend_u,
                         Direction::Weft => fr_bend_v,
@@ -345,25 +349,25 @@ impl Assembly {
                     if let Some(f) = fr {
                         // SAFETY: element c·CHUNK + k is visited by this iteration only.
                         let st = unsafe { &mut *st_b.at(c * CHUNK + k) };
-                        let q = el.curvature(x);
                         if st[0].x.is_nan() {
-                            *st = [q, Vec3::zeros()];
+                            *st = [geo.qn, Vec3::zeros()];
                         }
-                        let m_el = law.bending(el.dir, q.norm()).0;
-                        let (z, t) = bend_friction(&f, &st[0], &st[1], &q, m_el);
-                        *st = [q, z];
-                        gen += z * el.area;
-                        s += t * el.area;
+                        let (z, t) = bend_friction(&f, &st[0], &st[1], &geo.qn, m_el);
+                        *st = [geo.qn, z];
+                        mv += z;
+                        s += t;
                     }
-                    e += en;
+                    let s = s * f2;
+                    e += el.area * en;
+                    let forces = el.forces(&geo, &mv);
                     let [a, b, cc] = el.nodes;
                     let w = v[a] * el.coef[0] + v[b] * el.coef[1] + v[cc] * el.coef[2];
                     let sw = s * w;
                     let dw = s_el * w * beta_b;
-                    // f_m = −c_m (gen + β S_el w);  K v contribution c_m S w
+                    // f_m − β c_m S_el w (damping), and the K v term c_m S w
                     for m in 0..3 {
                         let cm = el.coef[m];
-                        g[3 * k + m] = -(gen + dw) * (cm * hf) - sw * (cm * hk);
+                        g[3 * k + m] = (forces[m] - dw * cm) * hf - sw * (cm * hk);
                     }
                     if matrix {
                         bl[k] = s * hk + s_el * (inp.dt * beta_b);

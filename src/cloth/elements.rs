@@ -153,6 +153,8 @@ pub struct BendLine {
     pub area: f64,
     /// Direction of the curvature it measures.
     pub dir: Direction,
+    /// Product of the rest spacings d1 d2 (m²).
+    pub rest_product: f64,
 }
 
 impl BendLine {
@@ -165,6 +167,7 @@ impl BendLine {
             coef: [ca, -(ca + cc), cc],
             area: width * 0.5 * (d1 + d2),
             dir,
+            rest_product: d1 * d2,
         }
     }
 
@@ -175,30 +178,65 @@ impl BendLine {
         x[a] * self.coef[0] + x[b] * self.coef[1] + x[c] * self.coef[2]
     }
 
-    /// Evaluates: (curvature vector q, M(κ), dM/dκ, energy). The force on node m is
-    /// `−area · M · c_m · q̂` and the stiffness block (m, n) is `c_m c_n · S` with
-    /// `S = area · (M' q̂q̂ᵀ + M/κ (I − q̂q̂ᵀ))`.
+    /// Curvature of the line, normalised by the current segment lengths so that stretching
+    /// does not read as bending: q' = q · d1 d2 / (l1 l2), with q the second difference,
+    /// d the rest and l the current spacings (points on a circle give |q'| = 1/R exactly,
+    /// whatever their spacing).
     #[inline]
-    pub fn eval(&self, law: &dyn MaterialLaw, x: &[Vec3]) -> (Vec3, Mat3, f64) {
+    pub fn geometry(&self, x: &[Vec3]) -> BendGeometry {
         let [a, b, c] = self.nodes;
-        let q = x[a] * self.coef[0] + x[b] * self.coef[1] + x[c] * self.coef[2];
-        let kappa = q.norm();
-        let (m, dm, w) = law.bending(self.dir, kappa);
-        if kappa < 1e-12 {
-            // M/κ → M'(0) as κ → 0
-            return (
-                q * (self.area * dm),
-                Mat3::identity() * (self.area * dm),
-                self.area * w,
-            );
+        let q = self.curvature(x);
+        let (e1, e2) = (x[b] - x[a], x[c] - x[b]);
+        let (l1, l2) = (e1.norm().max(1e-300), e2.norm().max(1e-300));
+        let len = l1 * l2;
+        let s = self.rest_product / len;
+        let (u1, u2) = (e1 / l1, e2 / l2);
+        BendGeometry {
+            qn: q * s,
+            scale: s,
+            len,
+            dlen: [-u1 * l2, u1 * l2 - u2 * l1, u2 * l1],
         }
-        let qh = q / kappa;
-        let ratio = m / kappa;
-        let qqt = qh * qh.transpose();
-        let s = (qqt * (dm - ratio) + Mat3::identity() * ratio) * self.area;
-        // generalised force vector: area · M · q̂  (node m gets −c_m times it)
-        (qh * (self.area * m), s, self.area * w)
     }
+
+    /// Forces on the three nodes of a moment vector `mv` (per width, in the space of q'):
+    /// f_m = −area (∂q'/∂x_m)ᵀ mv.
+    #[inline]
+    pub fn forces(&self, g: &BendGeometry, mv: &Vec3) -> [Vec3; 3] {
+        let t = g.qn.dot(mv) / g.len;
+        let f = |m: usize| -(mv * (g.scale * self.coef[m]) - g.dlen[m] * t) * self.area;
+        [f(0), f(1), f(2)]
+    }
+
+    /// Elastic moment vector and stiffness of the line at `g` for law (M, dM/dκ) at κ = |q'|:
+    /// (M q̂, S) with S the 3×3 factor of the blocks c_m c_n S (lengths held fixed in the
+    /// tangent, which keeps the blocks symmetric), before the area and scale factors.
+    #[inline]
+    pub fn elastic(g: &BendGeometry, m: f64, dm: f64) -> (Vec3, Mat3) {
+        let kappa = g.qn.norm();
+        if kappa < 1e-12 {
+            return (g.qn * dm, Mat3::identity() * dm);
+        }
+        let qh = g.qn / kappa;
+        let ratio = m / kappa;
+        (
+            qh * m,
+            qh * qh.transpose() * (dm - ratio) + Mat3::identity() * ratio,
+        )
+    }
+}
+
+/// Current shape of a bending line (see [`BendLine::geometry`]).
+#[derive(Debug, Clone, Copy)]
+pub struct BendGeometry {
+    /// Normalised curvature vector q' (1/m).
+    pub qn: Vec3,
+    /// d1 d2 / (l1 l2).
+    pub scale: f64,
+    /// l1 l2 (m²).
+    pub len: f64,
+    /// ∂(l1 l2)/∂x_m for the three nodes.
+    pub dlen: [Vec3; 3],
 }
 
 /// Shear of one grid cell, measured by its two diagonals: with d1 = x₁ − x₀ and d2 = x₃ − x₂
