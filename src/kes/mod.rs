@@ -2,3 +2,5 @@
 //! file format, the import of the Wang 2011 measured fabrics, and the KES parameter formulas
 //! applied to measured or simulated curves.
 pub mod rig;
+pub mod calibrate;
+pub mod damping;
