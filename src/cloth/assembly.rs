@@ -54,6 +54,15 @@ pub struct Assembly {
     fric_quad: Vec<[f64; 2]>,
     fric_bend: Vec<[Vec3; 2]>,
     fric_hinge: Vec<[f64; 2]>,
+    /// Trial friction states of the last evaluation (committed by [`Assembly::commit_friction`]).
+    trial_spring: Vec<[f64; 2]>,
+    trial_quad: Vec<[f64; 2]>,
+    trial_bend: Vec<[Vec3; 2]>,
+    trial_hinge: Vec<[f64; 2]>,
+    /// Commit the friction states after every assembly (true for time stepping, where every
+    /// assembly happens at an accepted state); quasi-static solvers set it false and commit
+    /// once an increment has converged.
+    pub auto_commit: bool,
 }
 
 /// What to assemble.
@@ -170,6 +179,11 @@ impl Assembly {
             fric_quad: Vec::new(),
             fric_bend: Vec::new(),
             fric_hinge: Vec::new(),
+            trial_spring: Vec::new(),
+            trial_quad: Vec::new(),
+            trial_bend: Vec::new(),
+            trial_hinge: Vec::new(),
+            auto_commit: true,
         }
     }
 
@@ -189,8 +203,15 @@ impl Assembly {
             self.fric_quad = vec![[f64::NAN, 0.0]; model.shear_quads.len()];
             self.fric_bend = vec![[Vec3::repeat(f64::NAN), Vec3::zeros()]; model.bend_lines.len()];
             self.fric_hinge = vec![[f64::NAN, 0.0]; model.hinges.len()];
+            self.trial_spring = self.fric_spring.clone();
+            self.trial_quad = self.fric_quad.clone();
+            self.trial_bend = self.fric_bend.clone();
+            self.trial_hinge = self.fric_hinge.clone();
         }
         let energy = self.element_pass(model, x, v, inp);
+        if self.auto_commit {
+            self.commit_friction();
+        }
         self.gather_pass(model, v, inp);
         energy
     }
@@ -233,10 +254,16 @@ impl Assembly {
         let fr_shear = law.shear_friction().filter(|_| friction);
         let fr_bend_u = law.bending_friction(Direction::Warp).filter(|_| friction);
         let fr_bend_v = law.bending_friction(Direction::Weft).filter(|_| friction);
-        let st_s = SyncPtr(self.fric_spring.as_mut_ptr());
-        let st_q = SyncPtr(self.fric_quad.as_mut_ptr());
-        let st_b = SyncPtr(self.fric_bend.as_mut_ptr());
-        let st_h = SyncPtr(self.fric_hinge.as_mut_ptr());
+        let (cm_s, cm_q, cm_b, cm_h) = (
+            &self.fric_spring,
+            &self.fric_quad,
+            &self.fric_bend,
+            &self.fric_hinge,
+        );
+        let st_s = SyncPtr(self.trial_spring.as_mut_ptr());
+        let st_q = SyncPtr(self.trial_quad.as_mut_ptr());
+        let st_b = SyncPtr(self.trial_bend.as_mut_ptr());
+        let st_h = SyncPtr(self.trial_hinge.as_mut_ptr());
         // springs
         model
             .springs
@@ -260,6 +287,7 @@ impl Assembly {
                     if let Some(f) = fr {
                         // SAFETY: element c·CHUNK + k is visited by this iteration only.
                         let st = unsafe { &mut *st_s.at(c * CHUNK + k) };
+                        *st = cm_s[c * CHUNK + k];
                         s.add_friction(&f, st, &x[s.a], &x[s.b], &mut ev);
                     }
                     let rel = v[s.b] - v[s.a];
@@ -294,6 +322,7 @@ impl Assembly {
                     if let Some(f) = fr_shear {
                         // SAFETY: element c·CHUNK + k is visited by this iteration only.
                         let st = unsafe { &mut *st_q.at(c * CHUNK + k) };
+                        *st = cm_q[c * CHUNK + k];
                         if st[0].is_nan() {
                             *st = [gamma, 0.0];
                         }
@@ -349,6 +378,7 @@ impl Assembly {
                     if let Some(f) = fr {
                         // SAFETY: element c·CHUNK + k is visited by this iteration only.
                         let st = unsafe { &mut *st_b.at(c * CHUNK + k) };
+                        *st = cm_b[c * CHUNK + k];
                         if st[0].x.is_nan() {
                             *st = [geo.qn, Vec3::zeros()];
                         }
@@ -412,6 +442,7 @@ impl Assembly {
                         if let Some(f) = fr {
                             // SAFETY: element c·CHUNK + k is visited by this iteration only.
                             let st = unsafe { &mut *st_h.at(c * CHUNK + k) };
+                            *st = cm_h[c * CHUNK + k];
                             let ks = theta * el.edge / el.area;
                             if st[0].is_nan() {
                                 *st = [ks, 0.0];
@@ -504,6 +535,20 @@ impl Assembly {
 }
 
 impl Assembly {
+    /// Friction states (committed coordinate, friction force per width) of the springs; empty
+    /// when the law has no friction.
+    pub fn spring_friction(&self) -> &[[f64; 2]] {
+        &self.fric_spring
+    }
+
+    /// Makes the friction states of the last evaluation the committed ones.
+    pub fn commit_friction(&mut self) {
+        self.fric_spring.copy_from_slice(&self.trial_spring);
+        self.fric_quad.copy_from_slice(&self.trial_quad);
+        self.fric_bend.copy_from_slice(&self.trial_bend);
+        self.fric_hinge.copy_from_slice(&self.trial_hinge);
+    }
+
     /// Forms the block-Jacobi preconditioner from the assembled matrix.
     pub fn form_block_jacobi(&mut self) {
         let a = &self.a;

@@ -290,6 +290,25 @@ impl LawModel {
         })
     }
 
+    /// True when any mode is built from KES parameters (so fitting applies).
+    pub fn has_kes_modes(&self) -> bool {
+        self.tension
+            .iter()
+            .any(|t| matches!(t, TensileModel::Kes { .. }))
+            || self.shear_is_kes()
+            || (0..2).any(|d| self.bending_is_kes(d))
+    }
+
+    /// True when shear comes from KES parameters.
+    pub fn shear_is_kes(&self) -> bool {
+        self.shear_curve.is_none()
+    }
+
+    /// True when bending along direction `d` (0 warp, 1 weft) comes from KES parameters.
+    pub fn bending_is_kes(&self, d: usize) -> bool {
+        self.bending_curves[d].is_none()
+    }
+
     /// The material law of the model's current parameters.
     pub fn law(&self) -> MeasuredLaw {
         let mut tension = [ResponseCurve::linear(0.0), ResponseCurve::linear(0.0)];

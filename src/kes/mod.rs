@@ -1,6 +1,17 @@
 //! Measured fabrics: the KES-F units and their conversion to SI (in one place), the fabric
-//! file format, the import of the Wang 2011 measured fabrics, and the KES parameter formulas
-//! applied to measured or simulated curves.
-pub mod rig;
+//! file format, the import of the Wang 2011 measured fabrics, the KES parameter formulas
+//! applied to measured or simulated curves, the virtual Kawabata rigs, the law built from
+//! measurements and its fitting, damping from free oscillation, and the lab that runs it all.
+
 pub mod calibrate;
 pub mod damping;
+pub mod error;
+pub mod fabric;
+pub mod lab;
+pub mod parameters;
+pub mod rig;
+pub mod units;
+pub mod wang;
+
+pub use error::KesError;
+pub use fabric::{read_fabric, read_fabric_dir, write_fabric, Curve, FabricSpec, KesParam, KesValues};

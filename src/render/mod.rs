@@ -3,6 +3,7 @@
 //! triangle rasterizer that draws [`RenderMesh`]es into an RGB image or a PNG file.
 
 pub mod camera;
+pub mod plot;
 pub mod raster;
 mod shading;
 

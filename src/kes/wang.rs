@@ -1,0 +1,186 @@
+//! Import of the ten measured fabrics of Wang, O'Brien & Ramamoorthi 2011 ("Data-Driven
+//! Elastic Models for Cloth", ACM TOG 30(4):71, doi 10.1145/2010324.1964966), as distributed
+//! with ARCSim, into our fabric format. Their licence (ARCSim's: education, research,
+//! not-for-profit) forbids redistribution in a commercial product, so the conversion runs at
+//! run time into an output folder; nothing derived from them is committed.
+//!
+//! ARCSim's reading of the numbers (maths notes §2.1): `density` kg/m²; `stretching` rows of
+//! (c11, c12, c22, c33) N/m, row 0 at zero strain, rows 1–5 at principal stretch 1 + 1/6 for
+//! principal directions 0°, 22.5°, 45°, 67.5°, 90° from u, interpolated linearly in the strain
+//! coordinate 6 (stretch − 1), doubled, in W = ½(k0 Guu² + k2 Gvv² + 2 k1 Guu Gvv + k3 Guv²)
+//! with Green strain G; `bending` rows for hinge edges at 0°, 45°, 90° from u, columns at
+//! curvature 0, 10, 20, 30, 40 1/m, N·m. We take u as the warp (the files do not say).
+//!
+//! Conversion (documented in every file's provenance):
+//! - tensile (strip-biaxial, width held): k(ε) = 2·lerp(c_row0, c_row, min(6ε, 1)),
+//!   F(ε) = (1 + ε) k(ε) (ε + ε²/2), ε = 0 … 1/6 every 0.5 % (warp: c11, row 1; weft: c22, row 5);
+//! - shear as the KES-FB1 instrument would read it under its 10 gf/cm tension:
+//!   H(φ) = (c33(φ)/2) φ + W tan φ, c33(φ) = lerp(c33_row0, c33_row3, min(3|φ|, 1)),
+//!   0 … 8° every 0.5°;
+//! - bending: M(κ) = k(κ) κ with k interpolated along the row, 0 … 0.4 1/cm every 0.025 1/cm;
+//!   curvature along the warp bends about hinges at 90° from u (row 2), along the weft row 0,
+//!   bias row 1. ARCSim's hinge normalisation makes the table value the rigidity within ~25 %;
+//!   we take it as B.
+
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+
+use super::calibrate::SHEAR_TENSION;
+use super::error::KesError;
+use super::fabric::{write_fabric, Curve, FabricCurves, FabricSpec, KesValues};
+
+fn field_err(file: &str, field: &str, message: impl Into<String>) -> KesError {
+    KesError::Field {
+        file: file.into(),
+        field: field.into(),
+        message: message.into(),
+    }
+}
+
+fn table(v: &Value, file: &str, key: &str, rows: usize, cols: usize) -> Result<Vec<Vec<f64>>, KesError> {
+    let arr = v
+        .get(key)
+        .and_then(|a| a.as_array())
+        .filter(|a| a.len() == rows)
+        .ok_or_else(|| field_err(file, key, format!("expected {rows} rows")))?;
+    arr.iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let r = r
+                .as_array()
+                .filter(|r| r.len() == cols)
+                .ok_or_else(|| field_err(file, &format!("{key}[{i}]"), format!("expected {cols} values")))?;
+            r.iter()
+                .map(|x| {
+                    x.as_f64()
+                        .filter(|x| x.is_finite() && *x >= 0.0)
+                        .ok_or_else(|| field_err(file, &format!("{key}[{i}]"), "values must be finite and ≥ 0"))
+                })
+                .collect()
+        })
+        .collect()
+}
+
+fn lerp(a: f64, b: f64, t: f64) -> f64 {
+    a + (b - a) * t
+}
+
+/// Converts one ARCSim/Wang material file.
+pub fn import_wang(path: &Path) -> Result<FabricSpec, KesError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| KesError::Io {
+        file: file.clone(),
+        message: e.to_string(),
+    })?;
+    let v: Value = serde_json::from_str(&text).map_err(|e| KesError::Syntax {
+        file: file.clone(),
+        line: e.line(),
+        column: e.column(),
+        message: e.to_string(),
+    })?;
+    let density = v
+        .get("density")
+        .and_then(|d| d.as_f64())
+        .filter(|d| d.is_finite() && *d > 0.0)
+        .ok_or_else(|| field_err(&file, "density", "expected a positive number"))?;
+    let st = table(&v, &file, "stretching", 6, 4)?;
+    let bend = table(&v, &file, "bending", 3, 5)?;
+    let tensile = |col: usize, row: usize| -> Curve {
+        let loading = (0..=34)
+            .map(|k| {
+                let e = (k as f64 * 0.005).min(1.0 / 6.0);
+                let kk = 2.0 * lerp(st[0][col], st[row][col], (6.0 * e).min(1.0));
+                [e, (1.0 + e) * kk * (e + 0.5 * e * e)]
+            })
+            .collect();
+        Curve {
+            loading,
+            unloading: Vec::new(),
+        }
+    };
+    let d = std::f64::consts::PI / 180.0;
+    let shear = Curve {
+        loading: (0..=16)
+            .map(|k| {
+                let phi = k as f64 * 0.5 * d;
+                let c33 = lerp(st[0][3], st[3][3], (3.0 * phi).min(1.0));
+                [phi, 0.5 * c33 * phi + SHEAR_TENSION * phi.tan()]
+            })
+            .collect(),
+        unloading: Vec::new(),
+    };
+    let bending = |row: usize| -> Curve {
+        let loading = (0..=16)
+            .map(|k| {
+                let kappa = k as f64 * 2.5; // 1/m: 0 … 40
+                let s = kappa / 10.0;
+                let i = (s.floor() as usize).min(3);
+                let kk = lerp(bend[row][i], bend[row][i + 1], s - i as f64);
+                [kappa, kk * kappa]
+            })
+            .collect();
+        Curve {
+            loading,
+            unloading: Vec::new(),
+        }
+    };
+    let warp = tensile(0, 1);
+    let weft = tensile(2, 5);
+    let fm = warp.loading.last().unwrap()[1].max(weft.loading.last().unwrap()[1]);
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_default();
+    Ok(FabricSpec {
+        description: format!("{name}: measured by Wang, O'Brien & Ramamoorthi 2011 (ARCSim material)"),
+        provenance: format!(
+            "Converted at run time from {file} (Wang, O'Brien, Ramamoorthi, \"Data-Driven Elastic Models for Cloth\", \
+             ACM TOG 30(4):71, 2011, doi 10.1145/2010324.1964966; ARCSim licence: educational, research and \
+             not-for-profit use, not redistributed). u taken as the warp. Tensile (width held): \
+             k(e) = 2 lerp(c_row0, c_row, min(6e,1)), F = (1+e) k(e) (e + e^2/2), warp c11/row 1, weft c22/row 5, \
+             to e = 1/6. Shear as read by KES-FB1 under 10 gf/cm: H = (c33(phi)/2) phi + W tan(phi), \
+             c33 = lerp(row0, row3, min(3|phi|,1)), to 8 deg. Bending: M = k(kappa) kappa, warp = row 2 \
+             (hinge at 90 deg), weft = row 0, bias = row 1, to 0.4 1/cm; table value taken as B (ARCSim's \
+             hinge normalisation: within ~25 %). No KES parameters: they are computed from the curves."
+        ),
+        name,
+        path: file.clone(),
+        density,
+        thickness: None,
+        warp: KesValues::default(),
+        weft: KesValues::default(),
+        curves: FabricCurves {
+            tensile_warp: Some(warp),
+            tensile_weft: Some(weft),
+            tensile_bias: None,
+            shear: Some(shear),
+            bending_warp: Some(bending(2)),
+            bending_weft: Some(bending(0)),
+            bending_bias: Some(bending(1)),
+        },
+        tensile_fm: fm,
+    })
+}
+
+/// Converts every `*.json` material of `dir` into our format under `out_dir` (same stems);
+/// returns the written paths, sorted.
+pub fn import_wang_dir(dir: &Path, out_dir: &Path) -> Result<Vec<PathBuf>, KesError> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| KesError::Io {
+            file: dir.display().to_string(),
+            message: e.to_string(),
+        })?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "json"))
+        .collect();
+    files.sort();
+    let mut out = Vec::new();
+    for f in files {
+        let spec = import_wang(&f)?;
+        let target = out_dir.join(format!("{}.json", spec.name));
+        write_fabric(&target, &spec)?;
+        out.push(target);
+    }
+    Ok(out)
+}
