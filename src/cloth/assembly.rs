@@ -9,7 +9,7 @@
 use rayon::prelude::*;
 
 use super::bcsr::{Bcsr3, Sym3f};
-use super::elements::{bend_friction, BendLine, SpringKind};
+use super::elements::{BendLine, SpringKind};
 use super::material::Direction;
 use super::model::ClothModel;
 use super::parallel::{chunks, ordered_sum, SyncPtr, CHUNK};
@@ -201,7 +201,8 @@ impl Assembly {
             // once per topology: friction states start unseen (taken at the first evaluation)
             self.fric_spring = vec![[f64::NAN, 0.0]; model.springs.len()];
             self.fric_quad = vec![[f64::NAN, 0.0]; model.shear_quads.len()];
-            self.fric_bend = vec![[Vec3::repeat(f64::NAN), Vec3::zeros()]; model.bend_lines.len()];
+            self.fric_bend =
+                vec![[Vec3::repeat(f64::NAN), Vec3::zeros()]; model.bend_lines.len()];
             self.fric_hinge = vec![[f64::NAN, 0.0]; model.hinges.len()];
             self.trial_spring = self.fric_spring.clone();
             self.trial_quad = self.fric_quad.clone();
@@ -316,7 +317,8 @@ impl Assembly {
                 let mut e = 0.0;
                 for k in 0..qs.len() {
                     let q = &qs[k];
-                    let (d1, d2, gamma) = q.measure(x);
+                    let sm = q.measure(x);
+                    let gamma = sm.gamma;
                     let (mut hs, mut dhs, w) = law.shear(gamma);
                     let dhs_el = dhs;
                     if let Some(f) = fr_shear {
@@ -332,18 +334,20 @@ impl Assembly {
                         dhs += dz;
                     }
                     e += q.area * w;
-                    let g2 = 2.0 * q.inv;
-                    for (m, (d, sign)) in [(d1, 1.0), (d2, -1.0)].into_iter().enumerate() {
+                    for m in 0..2 {
                         let (a, b) = (q.nodes[2 * m], q.nodes[2 * m + 1]);
+                        let d = sm.d[m];
+                        // γ depends on |d|² with slope dg: ∂γ/∂x_b = 2 dg d
+                        let gk = 2.0 * sm.dg[m];
                         let rel = v[b] - v[a];
                         let ddt = d * d.transpose();
-                        let axial = ddt * (2.0 * q.area * g2 * g2);
+                        let axial = ddt * (2.0 * q.area * gk * gk);
                         let cdamp = axial * (beta_s * dhs_el);
                         // force on the diagonal's first node (the second gets the opposite)
-                        let mut ga = d * (sign * q.area * hs * g2 * hf) + cdamp * rel * hf;
+                        let mut ga = d * (q.area * hs * gk * hf) + cdamp * rel * hf;
                         if matrix {
                             let kmat = axial * dhs.max(0.0)
-                                + Mat3::identity() * (sign * q.area * hs * g2).max(0.0);
+                                + Mat3::identity() * (q.area * hs * gk).max(0.0);
                             ga += kmat * rel * hk;
                             bl[2 * k + m] = kmat * hk + cdamp * inp.dt;
                         }
@@ -379,13 +383,27 @@ impl Assembly {
                         // SAFETY: element c·CHUNK + k is visited by this iteration only.
                         let st = unsafe { &mut *st_b.at(c * CHUNK + k) };
                         *st = cm_b[c * CHUNK + k];
+                        // scalar friction on the signed curvature, its sign kept continuous
+                        // through the reference direction st[1] (rotation does not slide it)
+                        let r_old = st[1];
+                        let sgn = if r_old.dot(&geo.qn) < 0.0 { -1.0 } else { 1.0 };
+                        let ks = sgn * kappa;
                         if st[0].x.is_nan() {
-                            *st = [geo.qn, Vec3::zeros()];
+                            st[0] = Vec3::new(ks, 0.0, 0.0);
                         }
-                        let (z, t) = bend_friction(&f, &st[0], &st[1], &geo.qn, m_el);
-                        *st = [geo.qn, z];
-                        mv += z;
-                        s += t;
+                        let (z, dz) = f.update(st[0].x, st[0].y, ks, sgn * m_el, dm);
+                        if kappa > 1e-9 {
+                            let qh = geo.qn / kappa;
+                            let qq = qh * qh.transpose();
+                            mv += qh * (sgn * z);
+                            s += qq * dz.max(0.0)
+                                + (Mat3::identity() - qq) * (sgn * z / kappa).max(0.0);
+                            st[1] = qh * sgn;
+                        } else {
+                            mv += r_old * z;
+                            s += Mat3::identity() * dz.max(0.0);
+                        }
+                        st[0] = Vec3::new(ks, z, 0.0);
                     }
                     let s = s * f2;
                     e += el.area * en;

@@ -239,33 +239,62 @@ pub struct BendGeometry {
     pub dlen: [Vec3; 3],
 }
 
-/// Shear of one grid cell, measured by its two diagonals: with d1 = x₁ − x₀ and d2 = x₃ − x₂
-/// the diagonals of a cell of rest sides a × b, `γ = (|d1|² − |d2|²) / (4ab)` (= u·v/(ab), the
-/// sine of the shear angle for unstretched sides). Energy `area · W(γ)`. Pure stretch leaves
-/// γ = 0, so tensile tests see no shear stiffness (unlike independent diagonal springs).
+/// Shear of one grid cell, measured by its two diagonals d1 = x₁ − x₀ and d2 = x₃ − x₂ of a
+/// cell of rest sides a × b: with A = |d1|², B = |d2|²,
+/// `γ = (A − B)/(A + B) · (a² + b²)/(2ab)`, the sine of the shear angle for a cell stretched
+/// equally along both sides and nearly so otherwise (the ratio removes the stretch, so a knit
+/// pre-stretched by the shear test's tension does not read its stretch as shear). Pure stretch
+/// along the yarns leaves γ = 0, so tensile tests see no shear stiffness (unlike independent
+/// diagonal springs). Energy `area · W(γ)`.
 ///
 /// Its stiffness is approximated per diagonal, spring-like (symmetric 3×3 blocks, as the
 /// multigrid smoother needs): `2·area·W''·g_k g_kᵀ` plus the positive part of the
-/// `area·W'·∂²γ` term, with g_k = 2 d_k/(4ab). This is exact for pure shear and over-stiff
-/// (by a shear-sized amount) only for dilation, which keeps the implicit step stable.
+/// `area·W'·∂²γ/∂d_k²` term, with g_k = ∂γ/∂d_k. This is exact for pure shear of a square cell
+/// and over-stiff only for dilation, which keeps the implicit step stable.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShearQuad {
     /// Diagonal 1 (from, to) then diagonal 2 (from, to).
     pub nodes: [usize; 4],
-    /// 1/(4ab) (1/m²).
+    /// (a² + b²)/(2ab).
     pub inv: f64,
     /// Rest area ab of fabric the element stands for (m²).
     pub area: f64,
 }
 
+/// Current shape of a shear cell (see [`ShearQuad::measure`]).
+#[derive(Debug, Clone, Copy)]
+pub struct ShearMeasure {
+    /// The diagonals.
+    pub d: [Vec3; 2],
+    /// Shear γ.
+    pub gamma: f64,
+    /// ∂γ/∂(|d_k|²) for k = 1, 2.
+    pub dg: [f64; 2],
+}
+
 impl ShearQuad {
-    /// The diagonals d1, d2 and γ at positions `x`.
+    /// A cell of rest sides `a` × `b` with the given diagonal node pairs.
+    pub fn new(nodes: [usize; 4], a: f64, b: f64) -> Self {
+        ShearQuad {
+            nodes,
+            inv: (a * a + b * b) / (2.0 * a * b),
+            area: a * b,
+        }
+    }
+
+    /// The diagonals, γ and its derivatives at positions `x`.
     #[inline]
-    pub fn measure(&self, x: &[Vec3]) -> (Vec3, Vec3, f64) {
+    pub fn measure(&self, x: &[Vec3]) -> ShearMeasure {
         let [a1, b1, a2, b2] = self.nodes;
         let d1 = x[b1] - x[a1];
         let d2 = x[b2] - x[a2];
-        (d1, d2, (d1.norm_squared() - d2.norm_squared()) * self.inv)
+        let (p, q) = (d1.norm_squared(), d2.norm_squared());
+        let s = (p + q).max(1e-300);
+        ShearMeasure {
+            d: [d1, d2],
+            gamma: (p - q) / s * self.inv,
+            dg: [2.0 * q / (s * s) * self.inv, -2.0 * p / (s * s) * self.inv],
+        }
     }
 }
 

@@ -78,11 +78,11 @@ impl ClothModel {
                     });
                 }
                 if i + 1 < ny && j + 1 < nx {
-                    shear_quads.push(ShearQuad {
-                        nodes: [id(i, j), id(i + 1, j + 1), id(i, j + 1), id(i + 1, j)],
-                        inv: 1.0 / (4.0 * dx * dy),
-                        area: dx * dy,
-                    });
+                    shear_quads.push(ShearQuad::new(
+                        [id(i, j), id(i + 1, j + 1), id(i, j + 1), id(i + 1, j)],
+                        dx,
+                        dy,
+                    ));
                 }
                 if j >= 1 && j + 1 < nx {
                     bend_lines.push(BendLine::new(

@@ -389,28 +389,49 @@ pub struct RigRun {
     pub bending: [RigCurve; 2],
 }
 
-/// Runs every rig on `mesh` with the model's law.
-pub fn run_rigs(model: &LawModel, mesh: RigMesh) -> Result<RigRun, ClothError> {
+/// Which rigs to run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Tests {
+    /// Tensile, warp and weft.
+    pub tensile: bool,
+    /// Shear.
+    pub shear: bool,
+    /// Pure bending, warp and weft.
+    pub bending: bool,
+}
+
+impl Tests {
+    /// Every rig.
+    pub const ALL: Tests = Tests {
+        tensile: true,
+        shear: true,
+        bending: true,
+    };
+}
+
+/// Runs the rigs of `tests` on `mesh` with the model's law (the others stay empty).
+pub fn run_rigs(model: &LawModel, mesh: RigMesh, tests: Tests) -> Result<RigRun, ClothError> {
     let law: Arc<dyn MaterialLaw> = Arc::new(model.law());
     let p = &model.protocol;
     let dirs = [Direction::Warp, Direction::Weft];
     let mut run = RigRun::default();
     for d in 0..2 {
-        run.tensile[d] = rig::tensile(law.clone(), model.density, dirs[d], p.tensile_fm[d], mesh)?;
-        run.bending[d] = rig::bending(
-            law.clone(),
-            model.density,
-            dirs[d],
-            p.bending_amplitude[d],
-            mesh,
-        )?;
+        if tests.tensile {
+            run.tensile[d] =
+                rig::tensile(law.clone(), model.density, dirs[d], p.tensile_fm[d], mesh)?;
+        }
+        if tests.bending {
+            run.bending[d] = rig::bending(
+                law.clone(),
+                model.density,
+                dirs[d],
+                p.bending_amplitude[d],
+                mesh,
+            )?;
+        }
     }
-    run.shear = rig::shear(
-        law,
-        model.density,
-        p.shear_tension,
-        p.shear_amplitude,
-        mesh,
-    )?;
+    if tests.shear {
+        run.shear = rig::shear(law, model.density, p.shear_tension, p.shear_amplitude, mesh)?;
+    }
     Ok(run)
 }

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::calibrate::{self, interp, LawModel, Measurements, ModeData, RigRun, TensileModel};
+use super::calibrate::{self, interp, LawModel, Measurements, ModeData, RigRun, TensileModel, Tests};
 use super::fabric::{Curve, FabricSpec, KesParam};
 use super::parameters::{bending_parameters, shear_parameters, tensile_parameters};
 use super::rig::{self, RigCurve, RigMesh};
@@ -24,6 +24,8 @@ pub struct LabOptions {
     pub fit_rounds: usize,
     /// Run the Peirce cantilever too.
     pub cantilever: bool,
+    /// Which rigs to run.
+    pub tests: Tests,
 }
 
 impl Default for LabOptions {
@@ -36,6 +38,7 @@ impl Default for LabOptions {
             fit: true,
             fit_rounds: 8,
             cantilever: true,
+            tests: Tests::ALL,
         }
     }
 }
@@ -139,6 +142,9 @@ pub fn measurements(spec: &FabricSpec) -> Measurements {
 /// backward (x decreasing from the maximum) and forward (x increasing from the minimum)
 /// branches, each sorted by x.
 pub fn branches(path: &[[f64; 2]]) -> (Vec<[f64; 2]>, Vec<[f64; 2]>, Vec<[f64; 2]>) {
+    if path.is_empty() {
+        return (Vec::new(), Vec::new(), Vec::new());
+    }
     let imax = (0..path.len())
         .max_by(|&a, &b| path[a][0].total_cmp(&path[b][0]))
         .unwrap_or(0);
@@ -212,10 +218,11 @@ fn fit(
     model: &mut LawModel,
     mesh: RigMesh,
     rounds: usize,
+    tests: Tests,
 ) -> Result<usize, String> {
     let mut used = 0;
     for round in 0..rounds {
-        let run = calibrate::run_rigs(model, mesh).map_err(|e| e.to_string())?;
+        let run = calibrate::run_rigs(model, mesh, tests).map_err(|e| e.to_string())?;
         let sim = simulated_params(&run, model);
         let get = |test: &str, p: KesParam| {
             sim.iter()
@@ -310,7 +317,7 @@ pub fn run_fabric(spec: &FabricSpec, opts: &LabOptions) -> Result<FabricReport, 
     let mut rounds = 0;
     if opts.fit && model.has_kes_modes() {
         let mesh = opts.meshes.first().map_or(RigMesh::COARSE, |m| m.1);
-        rounds = fit(spec, &mut model, mesh, opts.fit_rounds)
+        rounds = fit(spec, &mut model, mesh, opts.fit_rounds, opts.tests)
             .map_err(|e| format!("{}: fitting: {e}", display_path(spec)))?;
     }
     let mut report = FabricReport {
@@ -337,7 +344,7 @@ pub fn run_fabric(spec: &FabricSpec, opts: &LabOptions) -> Result<FabricReport, 
         }
     }
     for (mesh_name, mesh) in &opts.meshes {
-        let run = calibrate::run_rigs(&model, *mesh)
+        let run = calibrate::run_rigs(&model, *mesh, opts.tests)
             .map_err(|e| format!("{}: {e}", display_path(spec)))?;
         for (test, v) in simulated_params(&run, &model) {
             for (p, s) in v {
@@ -362,6 +369,9 @@ pub fn run_fabric(spec: &FabricSpec, opts: &LabOptions) -> Result<FabricReport, 
         }
         for (test, input) in &report.inputs {
             let path = test_path(&run, test);
+            if path.path.is_empty() {
+                continue;
+            }
             let (virgin, _, _) = branches(&path.path);
             if let Some(rms) = curve_rms_pct(input, &virgin) {
                 report.curves.push(CurveRow {
@@ -374,7 +384,13 @@ pub fn run_fabric(spec: &FabricSpec, opts: &LabOptions) -> Result<FabricReport, 
         report.runs.push((mesh_name.clone(), run));
     }
     if opts.cantilever {
-        let law = std::sync::Arc::new(model.law());
+        // the Peirce test of the elastic backbone (friction would hold a monotonically loaded
+        // strip up by its threshold moment, as in real cantilever tests)
+        let mut elastic = model.law();
+        elastic.bending_friction = [None, None];
+        elastic.tension_friction = [None, None];
+        elastic.shear_friction = None;
+        let law = std::sync::Arc::new(elastic);
         let b = law.bending(Direction::Warp, 1e-3).1;
         let q = spec.density * 9.81;
         let theory = (b / q).cbrt();
@@ -455,6 +471,9 @@ pub fn write_fabric_outputs(report: &FabricReport, dir: &Path) -> Result<Vec<Pat
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let mut written = Vec::new();
     for test in ["tensile_warp", "tensile_weft", "shear", "bending_warp", "bending_weft"] {
+        if report.runs.iter().all(|(_, r)| test_path(r, test).path.is_empty()) {
+            continue;
+        }
         let (xl, yl, fx, fy) = axes(test);
         let scale = |pts: &[[f64; 2]]| -> Vec<[f64; 2]> {
             pts.iter().map(|p| [p[0] * fx, p[1] * fy]).collect()

@@ -19,8 +19,9 @@
 //!   0 … 8° every 0.5°;
 //! - bending: M(κ) = k(κ) κ with k interpolated along the row, 0 … 0.4 1/cm every 0.025 1/cm;
 //!   curvature along the warp bends about hinges at 90° from u (row 2), along the weft row 0,
-//!   bias row 1. ARCSim's hinge normalisation makes the table value the rigidity within ~25 %;
-//!   we take it as B.
+//!   bias row 1, kept up to where M stops rising (several tables soften so fast beyond
+//!   30 1/m that M(κ) would fall, which no measured curve does). ARCSim's hinge normalisation
+//!   makes the table value the rigidity within ~25 %; we take it as B.
 
 use std::path::{Path, PathBuf};
 
@@ -38,7 +39,17 @@ fn field_err(file: &str, field: &str, message: impl Into<String>) -> KesError {
     }
 }
 
-fn table(v: &Value, file: &str, key: &str, rows: usize, cols: usize) -> Result<Vec<Vec<f64>>, KesError> {
+/// A `rows` × `cols` table of finite numbers; columns in `signed` may be negative (the
+/// stretching tables are fitted model parameters and hold a few negative entries), the
+/// others must be ≥ 0.
+fn table(
+    v: &Value,
+    file: &str,
+    key: &str,
+    rows: usize,
+    cols: usize,
+    signed: &[usize],
+) -> Result<Vec<Vec<f64>>, KesError> {
     let arr = v
         .get(key)
         .and_then(|a| a.as_array())
@@ -52,10 +63,13 @@ fn table(v: &Value, file: &str, key: &str, rows: usize, cols: usize) -> Result<V
                 .filter(|r| r.len() == cols)
                 .ok_or_else(|| field_err(file, &format!("{key}[{i}]"), format!("expected {cols} values")))?;
             r.iter()
-                .map(|x| {
+                .enumerate()
+                .map(|(j, x)| {
                     x.as_f64()
-                        .filter(|x| x.is_finite() && *x >= 0.0)
-                        .ok_or_else(|| field_err(file, &format!("{key}[{i}]"), "values must be finite and ≥ 0"))
+                        .filter(|x| x.is_finite() && (*x >= 0.0 || signed.contains(&j)))
+                        .ok_or_else(|| {
+                            field_err(file, &format!("{key}[{i}][{j}]"), "must be a finite number (≥ 0 for stiffnesses)")
+                        })
                 })
                 .collect()
         })
@@ -84,8 +98,8 @@ pub fn import_wang(path: &Path) -> Result<FabricSpec, KesError> {
         .and_then(|d| d.as_f64())
         .filter(|d| d.is_finite() && *d > 0.0)
         .ok_or_else(|| field_err(&file, "density", "expected a positive number"))?;
-    let st = table(&v, &file, "stretching", 6, 4)?;
-    let bend = table(&v, &file, "bending", 3, 5)?;
+    let st = table(&v, &file, "stretching", 6, 4, &[0, 1, 2, 3])?;
+    let bend = table(&v, &file, "bending", 3, 5, &[])?;
     let tensile = |col: usize, row: usize| -> Curve {
         let loading = (0..=34)
             .map(|k| {
@@ -111,7 +125,7 @@ pub fn import_wang(path: &Path) -> Result<FabricSpec, KesError> {
         unloading: Vec::new(),
     };
     let bending = |row: usize| -> Curve {
-        let loading = (0..=16)
+        let mut loading: Vec<[f64; 2]> = (0..=16)
             .map(|k| {
                 let kappa = k as f64 * 2.5; // 1/m: 0 … 40
                 let s = kappa / 10.0;
@@ -120,6 +134,11 @@ pub fn import_wang(path: &Path) -> Result<FabricSpec, KesError> {
                 [kappa, kk * kappa]
             })
             .collect();
+        // where the table's rigidity falls faster than 1/κ the moment would decrease, which no
+        // measured bending curve does (the strip would be unstable): keep the rising part
+        if let Some(k) = (1..loading.len()).find(|&k| loading[k][1] <= loading[k - 1][1]) {
+            loading.truncate(k);
+        }
         Curve {
             loading,
             unloading: Vec::new(),
@@ -141,7 +160,7 @@ pub fn import_wang(path: &Path) -> Result<FabricSpec, KesError> {
              k(e) = 2 lerp(c_row0, c_row, min(6e,1)), F = (1+e) k(e) (e + e^2/2), warp c11/row 1, weft c22/row 5, \
              to e = 1/6. Shear as read by KES-FB1 under 10 gf/cm: H = (c33(phi)/2) phi + W tan(phi), \
              c33 = lerp(row0, row3, min(3|phi|,1)), to 8 deg. Bending: M = k(kappa) kappa, warp = row 2 \
-             (hinge at 90 deg), weft = row 0, bias = row 1, to 0.4 1/cm; table value taken as B (ARCSim's \
+             (hinge at 90 deg), weft = row 0, bias = row 1, to 0.4 1/cm or where M stops rising; table value taken as B (ARCSim's \
              hinge normalisation: within ~25 %). No KES parameters: they are computed from the curves."
         ),
         name,

@@ -8,4 +8,7 @@ pub mod raster;
 mod shading;
 
 pub use camera::Camera;
+pub use plot::{
+    write_plot, write_plot_pair, write_series_csv, PlotError, PlotSpec, Series, SeriesStyle,
+};
 pub use raster::{render, render_png, RenderMesh};

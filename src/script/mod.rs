@@ -6,6 +6,7 @@
 //! - [`fabric`]: the `Fabric` value type and the `Cloth` handle (`fabric()`, `cloth_grid`, …);
 //! - [`sim`]: the `Simulation` handle: constraints, stepping, runs with per-frame callbacks;
 //! - [`output`]: positions, bounds, energies, OBJ/glTF/CSV/JSON/PNG output;
+//! - [`kes`]: the virtual Kawabata lab (fabric files, rigs, fitting, summaries);
 //! - [`run`], [`repl`], [`docs`]: running a file, the interactive loop, API documentation.
 //!
 //! Big objects cross into Rhai as shared handles (`Shared<Locked<_>>`), never copied per call.
@@ -13,6 +14,7 @@
 pub mod convert;
 pub mod docs;
 pub mod fabric;
+pub mod kes;
 pub mod output;
 pub mod repl;
 pub mod run;
@@ -100,6 +102,7 @@ pub fn build_engine_with(limits: EngineLimits) -> Engine {
     fabric::register(&mut engine);
     sim::register(&mut engine);
     output::register(&mut engine);
+    kes::register(&mut engine);
     engine
 }
 
