@@ -149,6 +149,8 @@ pub struct LawModel {
     /// Shear model; `shear_curve` replaces the linear elastic part when measured.
     pub shear: ShearModel,
     shear_curve: Option<ResponseCurve>,
+    /// The elastic shear points behind `shear_curve` (rad, N/m), adjusted by fitting.
+    shear_points: Vec<[f64; 2]>,
     /// Bending models (warp, weft).
     pub bending: [BendingModel; 2],
     bending_curves: [Option<ResponseCurve>; 2],
@@ -230,6 +232,7 @@ impl LawModel {
             c: 0.0,
         };
         let mut shear_curve = None;
+        let mut shear_points = Vec::new();
         if let Some(c) = &m.shear_curve {
             let (mean, mu) = loop_split(&c.loading, &c.unloading);
             let amp = mean.last().map_or(0.0, |p| p[0]);
@@ -241,6 +244,7 @@ impl LawModel {
                 .map(|p| [p[0], p[1] - SHEAR_TENSION * p[0].tan()])
                 .collect();
             shear_curve = Some(ResponseCurve::new(&el).map_err(|e| format!("curves.shear: {e}"))?);
+            shear_points = el.clone();
             if mu > 0.0 {
                 let end = el.last().map_or(0.0, |p| p[1]);
                 shear.a = mu * end;
@@ -285,6 +289,7 @@ impl LawModel {
             tension_curves,
             shear,
             shear_curve,
+            shear_points,
             bending,
             bending_curves,
         })
@@ -296,7 +301,30 @@ impl LawModel {
             .iter()
             .any(|t| matches!(t, TensileModel::Kes { .. }))
             || self.shear_is_kes()
+            || self.shear_is_curve()
             || (0..2).any(|d| self.bending_is_kes(d))
+    }
+
+    /// True when shear comes from a measured curve.
+    pub fn shear_is_curve(&self) -> bool {
+        self.shear_curve.is_some()
+    }
+
+    /// Corrects the elastic shear curve by `delta(x)` (N/m) at its points — the fitting step
+    /// for a measured shear curve (the specimen's free edges and the tension make the rig
+    /// read less than the material law). Returns the largest relative correction.
+    pub fn correct_shear_curve(&mut self, delta: impl Fn(f64) -> Option<f64>) -> f64 {
+        let mut worst: f64 = 0.0;
+        for p in self.shear_points.iter_mut().filter(|p| p[0] > 0.0) {
+            if let Some(d) = delta(p[0]) {
+                worst = worst.max((d / p[1].abs().max(1e-12)).abs());
+                p[1] += d;
+            }
+        }
+        if let Ok(c) = ResponseCurve::new(&self.shear_points) {
+            self.shear_curve = Some(c);
+        }
+        worst
     }
 
     /// True when shear comes from KES parameters.

@@ -163,12 +163,87 @@ fn ranges(spec: &PlotSpec) -> ((f64, f64), (f64, f64)) {
     (padded(x.0, x.1), padded(y.0, y.1))
 }
 
-/// The runs of consecutive finite points of `points`.
-fn finite_runs(points: &[[f64; 2]]) -> Vec<Vec<(f64, f64)>> {
+/// One axis as drawn: the plotted range in units of `10^exponent` (a power of ten noted in
+/// the axis label, for very large or very small values), the number of decimals of its tick
+/// labels and at most how many ticks it gets.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Axis {
+    lo: f64,
+    hi: f64,
+    exponent: i32,
+    decimals: usize,
+    ticks: usize,
+}
+
+impl Axis {
+    /// The axis for the (padded) range `lo..hi`, at most `ticks` ticks.
+    fn new((lo, hi): (f64, f64), ticks: usize) -> Axis {
+        let magnitude = lo.abs().max(hi.abs());
+        let e = if magnitude > 0.0 {
+            magnitude.log10().floor() as i32
+        } else {
+            0
+        };
+        // plotters gives a span under f64::EPSILON a single tick: scale small values up
+        let exponent = if (-3..5).contains(&e) {
+            0
+        } else {
+            e.clamp(-300, 300)
+        };
+        let unit = 10f64.powi(exponent);
+        let (lo, hi) = (lo / unit, hi / unit);
+        // ticks are 1, 2 or 5 × 10^k apart, at least (hi - lo) / ticks
+        let step = (hi - lo) / ticks as f64;
+        let decimals = if step > 0.0 && step.is_finite() {
+            (-step.log10().floor()).clamp(0.0, 12.0) as usize
+        } else {
+            1
+        };
+        Axis {
+            lo,
+            hi,
+            exponent,
+            decimals,
+            ticks,
+        }
+    }
+
+    /// A data value in plotted units.
+    fn map(&self, v: f64) -> f64 {
+        v / 10f64.powi(self.exponent)
+    }
+
+    /// The axis label, with the power of ten when there is one.
+    fn label(&self, text: &str) -> String {
+        match self.exponent {
+            0 => text.to_string(),
+            e => format!("{text}  [×1e{e}]"),
+        }
+    }
+
+    /// A tick label (no "-0.0").
+    fn tick(&self, v: f64) -> String {
+        let v = if v.abs() < 0.5 * 10f64.powi(-(self.decimals as i32)) {
+            0.0
+        } else {
+            v
+        };
+        format!("{:.*}", self.decimals, v)
+    }
+
+    /// About how many pixels its widest tick label needs.
+    fn tick_width(&self) -> u32 {
+        let chars = self.tick(self.lo).len().max(self.tick(self.hi).len());
+        9 * chars as u32
+    }
+}
+
+/// The runs of consecutive finite points of `points`, mapped to plotted units.
+fn finite_runs(points: &[[f64; 2]], x: &Axis, y: &Axis) -> Vec<Vec<(f64, f64)>> {
     points
         .split(|p| !finite(p))
         .filter(|run| !run.is_empty())
-        .map(|run| run.iter().map(|p| (p[0], p[1])).collect())
+        .map(|run| run.iter().map(|p| (x.map(p[0]), y.map(p[1]))).collect())
         .collect()
 }
 
@@ -178,18 +253,27 @@ where
 {
     let fail = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     root.fill(&WHITE).map_err(fail)?;
-    let ((x0, x1), (y0, y1)) = ranges(spec);
+    let (width, height) = root.dim_in_pixel();
+    let (xr, yr) = ranges(spec);
+    let x = Axis::new(xr, (width / 100).clamp(2, 10) as usize);
+    let y = Axis::new(yr, (height / 60).clamp(2, 10) as usize);
+    let tick_x = |v: &f64| x.tick(*v);
+    let tick_y = |v: &f64| y.tick(*v);
     let mut chart = ChartBuilder::on(root)
         .caption(&spec.title, (FONT_FAMILY, 22))
         .margin(14)
         .x_label_area_size(48)
-        .y_label_area_size(80)
-        .build_cartesian_2d(x0..x1, y0..y1)
+        .y_label_area_size(30 + y.tick_width())
+        .build_cartesian_2d(x.lo..x.hi, y.lo..y.hi)
         .map_err(fail)?;
     chart
         .configure_mesh()
-        .x_desc(&spec.x_label)
-        .y_desc(&spec.y_label)
+        .x_labels(x.ticks)
+        .y_labels(y.ticks)
+        .x_label_formatter(&tick_x)
+        .y_label_formatter(&tick_y)
+        .x_desc(x.label(&spec.x_label))
+        .y_desc(y.label(&spec.y_label))
         .label_style((FONT_FAMILY, 14))
         .axis_desc_style((FONT_FAMILY, 16))
         .draw()
@@ -199,7 +283,7 @@ where
         let [r, g, b] = series_colour(k);
         let colour = RGBColor(r, g, b);
         let line = colour.stroke_width(2);
-        let runs = finite_runs(&series.points);
+        let runs = finite_runs(&series.points, &x, &y);
         let annotation = match series.style {
             SeriesStyle::Markers => {
                 let points = runs.into_iter().flatten();
@@ -404,14 +488,36 @@ mod tests {
 
     #[test]
     fn runs_break_at_non_finite_points() {
-        let runs = finite_runs(&[
+        let axis = Axis::new((0.0, 1.0), 10);
+        let points = [
             [0.0, 0.0],
             [1.0, 1.0],
             [f64::NAN, 2.0],
             [3.0, 3.0],
             [4.0, f64::INFINITY],
-        ]);
+        ];
+        let runs = finite_runs(&points, &axis, &axis);
         assert_eq!(runs, vec![vec![(0.0, 0.0), (1.0, 1.0)], vec![(3.0, 3.0)]]);
+    }
+
+    #[test]
+    fn axes_scale_extreme_values_and_pick_decimals() {
+        let a = Axis::new((-0.5, 10.5), 10);
+        assert_eq!((a.exponent, a.decimals), (0, 0));
+        assert_eq!(a.tick(4.0), "4");
+        assert_eq!(a.label("x"), "x");
+        let a = Axis::new((-0.275, 0.275), 10);
+        assert_eq!((a.exponent, a.decimals), (0, 2));
+        assert_eq!(a.tick(-1e-17), "0.00");
+        let a = Axis::new((0.9e-12, 3.1e-12), 10);
+        assert_eq!(a.exponent, -12);
+        assert!((a.lo - 0.9).abs() < 1e-12 && (a.hi - 3.1).abs() < 1e-12);
+        assert_eq!(a.tick(2.5), "2.5");
+        assert_eq!(a.label("y"), "y  [×1e-12]");
+        let a = Axis::new((-1.1e300, 1.1e300), 10);
+        assert_eq!(a.exponent, 300);
+        assert!((a.map(1e300) - 1.0).abs() < 1e-12);
+        assert_eq!(Axis::new((-1.0, 1.0), 10).exponent, 0);
     }
 
     #[test]
