@@ -213,9 +213,83 @@ fn usage(name: &str) -> String {
     }
 }
 
+/// The lab scripts under `kawabata/`.
+fn lab_script_paths() -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("kawabata"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "rhai"))
+        .collect();
+    v.sort();
+    v
+}
+
+/// Runs `emilion run kawabata/NAME.rhai` with `sets`; returns stdout.
+fn run_lab_script(name: &str, sets: &[(&str, String)]) -> String {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_emilion"));
+    cmd.current_dir(root())
+        .arg("run")
+        .arg(format!("kawabata/{name}.rhai"));
+    for (k, v) in sets {
+        cmd.arg("--set").arg(format!("{k}={v}"));
+    }
+    let o = cmd.output().unwrap();
+    assert!(
+        o.status.success(),
+        "{name}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8_lossy(&o.stdout).to_string()
+}
+
+#[test]
+fn lab_scripts_run_and_write_plots() {
+    let fabric = root().join("tests/data/fabrics_small/shirting-cotton.json");
+    for name in ["tensile", "shear", "bending"] {
+        let out = temp_dir(&format!("lab_{name}"));
+        let stdout = run_lab_script(
+            name,
+            &[
+                ("fabric", fabric.display().to_string()),
+                ("out", out.display().to_string()),
+            ],
+        );
+        assert!(stdout.contains("measured"), "{name}: {stdout}");
+        let pngs = std::fs::read_dir(&out)
+            .unwrap()
+            .filter(|e| e.as_ref().unwrap().path().extension().is_some_and(|x| x == "png"))
+            .count();
+        assert!(pngs >= 1, "{name}: no plot in {}", out.display());
+    }
+    let stdout = run_lab_script("fit", &[("fabric", fabric.display().to_string())]);
+    assert!(stdout.contains("fitted stretch_damping"), "{stdout}");
+}
+
+#[test]
+fn lab_all_script_ends_with_the_summary_line() {
+    let out = temp_dir("lab_all");
+    let stdout = run_lab_script(
+        "all",
+        &[
+            ("fabrics", root().join("tests/data/fabrics_small").display().to_string()),
+            ("out", out.display().to_string()),
+            ("meshes", "coarse".into()),
+        ],
+    );
+    let last = stdout.lines().last().unwrap_or("");
+    assert!(
+        last.starts_with("worst_curve_rms_pct=") && last.contains(" worst_param_err_pct=") && last.ends_with(" fabrics=1"),
+        "{last}"
+    );
+    assert!(out.join("summary.csv").exists() && out.join("summary.md").exists());
+}
+
 #[test]
 fn every_function_is_used_by_a_script() {
     let all: String = script_paths()
+        .into_iter()
+        .chain(lab_script_paths())
+        .collect::<Vec<_>>()
         .iter()
         .map(|p| std::fs::read_to_string(p).unwrap())
         .collect();
