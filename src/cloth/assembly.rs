@@ -201,8 +201,7 @@ impl Assembly {
             // once per topology: friction states start unseen (taken at the first evaluation)
             self.fric_spring = vec![[f64::NAN, 0.0]; model.springs.len()];
             self.fric_quad = vec![[f64::NAN, 0.0]; model.shear_quads.len()];
-            self.fric_bend =
-                vec![[Vec3::repeat(f64::NAN), Vec3::zeros()]; model.bend_lines.len()];
+            self.fric_bend = vec![[Vec3::repeat(f64::NAN), Vec3::zeros()]; model.bend_lines.len()];
             self.fric_hinge = vec![[f64::NAN, 0.0]; model.hinges.len()];
             self.trial_spring = self.fric_spring.clone();
             self.trial_quad = self.fric_quad.clone();
@@ -490,10 +489,7 @@ impl Assembly {
                 });
             ordered_sum(&ep_h[..chunks(model.hinges.len(), CHUNK)])
         };
-        ordered_sum(&ep_s[..nsc])
-            + ordered_sum(&ep_q[..nqc])
-            + ordered_sum(&ep_b[..nbc])
-            + hinge_e
+        ordered_sum(&ep_s[..nsc]) + ordered_sum(&ep_q[..nqc]) + ordered_sum(&ep_b[..nbc]) + hinge_e
     }
 
     fn gather_pass(&mut self, model: &ClothModel, v: &[Vec3], inp: AssemblyInputs) {

@@ -148,7 +148,10 @@ impl Filter {
     /// particle is already fully fixed. A second normal on the same particle fixes the
     /// particle's velocity along both (approximated by keeping the newer normal).
     pub fn constrain_normal(&mut self, i: usize, normal: Vec3, velocity: f64) {
-        if matches!(self.kind[i], ParticleFilter::Free | ParticleFilter::Normal { .. }) {
+        if matches!(
+            self.kind[i],
+            ParticleFilter::Free | ParticleFilter::Normal { .. }
+        ) {
             self.kind[i] = ParticleFilter::Normal { normal, velocity };
             self.any = true;
         }

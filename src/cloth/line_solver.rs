@@ -276,8 +276,6 @@ const GROUP: usize = 128;
 fn group_size(dir: LineDir, count: usize) -> usize {
     match dir {
         LineDir::Warp => 1,
-        LineDir::Weft => count
-            .div_ceil(rayon::current_num_threads())
-            .clamp(1, GROUP),
+        LineDir::Weft => count.div_ceil(rayon::current_num_threads()).clamp(1, GROUP),
     }
 }

@@ -53,7 +53,12 @@ impl ResponseCurve {
             .map(|k| (ys[k + 1] - ys[k]) / (xs[k + 1] - xs[k]))
             .collect();
         let mut ds = vec![0.0; n];
-        ds[0] = end_slope(xs[1] - xs[0], xs.get(2).map(|x| x - xs[1]), sec[0], sec.get(1));
+        ds[0] = end_slope(
+            xs[1] - xs[0],
+            xs.get(2).map(|x| x - xs[1]),
+            sec[0],
+            sec.get(1),
+        );
         ds[n - 1] = end_slope(
             xs[n - 1] - xs[n - 2],
             (n > 2).then(|| xs[n - 2] - xs[n - 3]),
@@ -97,14 +102,7 @@ impl ResponseCurve {
         let k = self.xs.partition_point(|&v| v <= x).max(1) - 1;
         let h = self.xs[k + 1] - self.xs[k];
         let t = (x - self.xs[k]) / h;
-        let (y, dy) = hermite(
-            self.ys[k],
-            self.ys[k + 1],
-            self.ds[k],
-            self.ds[k + 1],
-            h,
-            t,
-        );
+        let (y, dy) = hermite(self.ys[k], self.ys[k + 1], self.ds[k], self.ds[k + 1], h, t);
         let mid = hermite(
             self.ys[k],
             self.ys[k + 1],

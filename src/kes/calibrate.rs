@@ -126,7 +126,9 @@ pub fn interp(branch: &[[f64; 2]], x: f64) -> Option<f64> {
     if branch.len() < 2 || x < branch[0][0] || x > branch[branch.len() - 1][0] {
         return None;
     }
-    let k = branch.partition_point(|p| p[0] <= x).clamp(1, branch.len() - 1);
+    let k = branch
+        .partition_point(|p| p[0] <= x)
+        .clamp(1, branch.len() - 1);
     let (a, b) = (branch[k - 1], branch[k]);
     let t = if b[0] > a[0] {
         (x - a[0]) / (b[0] - a[0])

@@ -168,7 +168,10 @@ pub fn fit_stretch_damping(
     let mut b1 = b0 * 1.2;
     let mut d1 = run(b1)?;
     for _ in 0..12 {
-        let (f0, f1) = (d0.log_decrement.ln() - target.ln(), d1.log_decrement.ln() - target.ln());
+        let (f0, f1) = (
+            d0.log_decrement.ln() - target.ln(),
+            d1.log_decrement.ln() - target.ln(),
+        );
         if f1.abs() < 1e-4 || (f1 - f0).abs() < 1e-14 {
             break;
         }

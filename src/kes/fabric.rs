@@ -166,9 +166,21 @@ const CURVES: [(&str, Quantity, Quantity); 7] = [
     ("tensile_weft", Quantity::Fraction, Quantity::ForcePerWidth),
     ("tensile_bias", Quantity::Fraction, Quantity::ForcePerWidth),
     ("shear", Quantity::Angle, Quantity::ForcePerWidth),
-    ("bending_warp", Quantity::Curvature, Quantity::MomentPerWidth),
-    ("bending_weft", Quantity::Curvature, Quantity::MomentPerWidth),
-    ("bending_bias", Quantity::Curvature, Quantity::MomentPerWidth),
+    (
+        "bending_warp",
+        Quantity::Curvature,
+        Quantity::MomentPerWidth,
+    ),
+    (
+        "bending_weft",
+        Quantity::Curvature,
+        Quantity::MomentPerWidth,
+    ),
+    (
+        "bending_bias",
+        Quantity::Curvature,
+        Quantity::MomentPerWidth,
+    ),
 ];
 
 impl FabricCurves {
@@ -282,8 +294,12 @@ impl Reader<'_> {
                 .as_array()
                 .filter(|a| a.len() == 2)
                 .ok_or_else(|| self.err(&f, "expected [x, y]"))?;
-            let x = pair[0].as_f64().ok_or_else(|| self.err(&f, "x must be a number"))?;
-            let y = pair[1].as_f64().ok_or_else(|| self.err(&f, "y must be a number"))?;
+            let x = pair[0]
+                .as_f64()
+                .ok_or_else(|| self.err(&f, "x must be a number"))?;
+            let y = pair[1]
+                .as_f64()
+                .ok_or_else(|| self.err(&f, "y must be a number"))?;
             if !(x.is_finite() && y.is_finite()) {
                 return Err(self.err(&f, "not finite"));
             }
@@ -379,18 +395,25 @@ pub fn parse_fabric(text: &str, file: &str) -> Result<FabricSpec, KesError> {
         return Err(r.err("format", format!("expected \"{FORMAT}\", got \"{format}\"")));
     }
     let name = text_field("name", true)?;
-    let weight = obj.get("weight").ok_or_else(|| r.err("weight", "missing"))?;
+    let weight = obj
+        .get("weight")
+        .ok_or_else(|| r.err("weight", "missing"))?;
     let density = r.quantity(weight, "weight", Quantity::ArealWeight)?;
     if density <= 0.0 {
         return Err(r.err("weight", format!("must be > 0, got {density}")));
     }
     let thickness = match obj.get("thickness") {
-        Some(v) => Some(r.non_negative(r.quantity(v, "thickness", Quantity::Thickness)?, "thickness")?),
+        Some(v) => Some(r.non_negative(
+            r.quantity(v, "thickness", Quantity::Thickness)?,
+            "thickness",
+        )?),
         None => None,
     };
     let mut dirs = [KesValues::default(), KesValues::default()];
     if let Some(kes) = obj.get("kes") {
-        let kes = kes.as_object().ok_or_else(|| r.err("kes", "expected an object"))?;
+        let kes = kes
+            .as_object()
+            .ok_or_else(|| r.err("kes", "expected an object"))?;
         for (dname, dv) in kes {
             let d = match dname.as_str() {
                 "warp" => 0,
@@ -407,7 +430,17 @@ pub fn parse_fabric(text: &str, file: &str) -> Result<FabricSpec, KesError> {
                 let v = r.non_negative(r.quantity(pv, &field, units::quantity_of(p))?, &field)?;
                 if let Some(u) = p.upper() {
                     if v > u {
-                        return Err(r.err(&field, format!("must be ≤ {}", if u == 1.0 && units::quantity_of(p) == Quantity::Fraction { "100 %" } else { "1" })));
+                        return Err(r.err(
+                            &field,
+                            format!(
+                                "must be ≤ {}",
+                                if u == 1.0 && units::quantity_of(p) == Quantity::Fraction {
+                                    "100 %"
+                                } else {
+                                    "1"
+                                }
+                            ),
+                        ));
                     }
                 }
                 dirs[d].set(p, v);
@@ -416,7 +449,9 @@ pub fn parse_fabric(text: &str, file: &str) -> Result<FabricSpec, KesError> {
     }
     let mut curves = FabricCurves::default();
     if let Some(cv) = obj.get("curves") {
-        let cv = cv.as_object().ok_or_else(|| r.err("curves", "expected an object"))?;
+        let cv = cv
+            .as_object()
+            .ok_or_else(|| r.err("curves", "expected an object"))?;
         for (key, v) in cv {
             let k = CURVES
                 .iter()
@@ -428,7 +463,9 @@ pub fn parse_fabric(text: &str, file: &str) -> Result<FabricSpec, KesError> {
     }
     let mut tensile_fm = STANDARD_FM;
     if let Some(p) = obj.get("protocol") {
-        let p = p.as_object().ok_or_else(|| r.err("protocol", "expected an object"))?;
+        let p = p
+            .as_object()
+            .ok_or_else(|| r.err("protocol", "expected an object"))?;
         for (k, v) in p {
             match k.as_str() {
                 "tensile_fm" => {
@@ -492,7 +529,10 @@ pub fn fabric_to_json(spec: &FabricSpec) -> Value {
     root.insert("name".into(), json!(spec.name));
     root.insert("description".into(), json!(spec.description));
     root.insert("provenance".into(), json!(spec.provenance));
-    root.insert("weight".into(), quantity_json(spec.density, Quantity::ArealWeight));
+    root.insert(
+        "weight".into(),
+        quantity_json(spec.density, Quantity::ArealWeight),
+    );
     if let Some(t) = spec.thickness {
         root.insert("thickness".into(), quantity_json(t, Quantity::Thickness));
     }

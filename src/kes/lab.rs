@@ -5,7 +5,9 @@
 
 use std::path::{Path, PathBuf};
 
-use super::calibrate::{self, interp, LawModel, Measurements, ModeData, RigRun, TensileModel, Tests};
+use super::calibrate::{
+    self, interp, LawModel, Measurements, ModeData, RigRun, TensileModel, Tests,
+};
 use super::fabric::{Curve, FabricSpec, KesParam};
 use super::parameters::{bending_parameters, shear_parameters, tensile_parameters};
 use super::rig::{self, RigCurve, RigMesh};
@@ -101,7 +103,10 @@ impl FabricReport {
     }
     /// Largest parameter error (%).
     pub fn worst_param(&self) -> f64 {
-        self.params.iter().map(|p| p.error_pct.abs()).fold(0.0, f64::max)
+        self.params
+            .iter()
+            .map(|p| p.error_pct.abs())
+            .fold(0.0, f64::max)
     }
 }
 
@@ -130,7 +135,13 @@ pub fn measurements(spec: &FabricSpec) -> Measurements {
         density: spec.density,
         tensile_fm: spec.tensile_fm,
         tensile_curve: [mode(&c.tensile_warp), mode(&c.tensile_weft)],
-        tensile_kes: [0, 1].map(|d| (kes(d, KesParam::Emt), kes(d, KesParam::Lt), kes(d, KesParam::Rt))),
+        tensile_kes: [0, 1].map(|d| {
+            (
+                kes(d, KesParam::Emt),
+                kes(d, KesParam::Lt),
+                kes(d, KesParam::Rt),
+            )
+        }),
         shear_curve: mode(&c.shear),
         shear_kes: (mean(KesParam::G), mean(KesParam::Hg2), mean(KesParam::Hg52)),
         bending_curve: [mode(&c.bending_warp), mode(&c.bending_weft)],
@@ -138,10 +149,13 @@ pub fn measurements(spec: &FabricSpec) -> Measurements {
     }
 }
 
+/// A curve branch: (x, y) points.
+pub type Branch = Vec<[f64; 2]>;
+
 /// Splits a rig path into its first rising run (virgin loading) and, for cycles, the
 /// backward (x decreasing from the maximum) and forward (x increasing from the minimum)
 /// branches, each sorted by x.
-pub fn branches(path: &[[f64; 2]]) -> (Vec<[f64; 2]>, Vec<[f64; 2]>, Vec<[f64; 2]>) {
+pub fn branches(path: &[[f64; 2]]) -> (Branch, Branch, Branch) {
     if path.is_empty() {
         return (Vec::new(), Vec::new(), Vec::new());
     }
@@ -170,7 +184,11 @@ fn simulated_params(run: &RigRun, model: &LawModel) -> Vec<(String, Vec<(KesPara
         let (load, back, _) = branches(&run.tensile[d].path);
         let mut v = Vec::new();
         if let Some(p) = tensile_parameters(&load, &back, model.protocol.tensile_fm[d]) {
-            v.extend([(KesParam::Emt, p.emt), (KesParam::Lt, p.lt), (KesParam::Wt, p.wt)]);
+            v.extend([
+                (KesParam::Emt, p.emt),
+                (KesParam::Lt, p.lt),
+                (KesParam::Wt, p.wt),
+            ]);
             if let Some(rt) = p.rt {
                 v.push((KesParam::Rt, rt));
             }
@@ -180,7 +198,11 @@ fn simulated_params(run: &RigRun, model: &LawModel) -> Vec<(String, Vec<(KesPara
     let (_, back, fwd) = branches(&run.shear.path);
     let mut v = Vec::new();
     if let Some(p) = shear_parameters(&fwd, &back) {
-        v.extend([(KesParam::G, p.g), (KesParam::Hg2, p.hg2), (KesParam::Hg52, p.hg5_2)]);
+        v.extend([
+            (KesParam::G, p.g),
+            (KesParam::Hg2, p.hg2),
+            (KesParam::Hg52, p.hg5_2),
+        ]);
     }
     out.push(("shear".into(), v));
     for (d, name) in ["bending_warp", "bending_weft"].iter().enumerate() {
@@ -255,9 +277,14 @@ fn fit(
             // measured curve: move the elastic points by the rig's shortfall at each angle
             if let Some(input) = spec.curves.shear.as_ref() {
                 let (virgin, _, _) = branches(&run.shear.path);
-                let meas: Vec<[f64; 2]> = input.loading.iter().filter(|p| p[0] >= 0.0).copied().collect();
-                curve_worst = model
-                    .correct_shear_curve(|x| Some(interp(&meas, x)? - interp(&virgin, x)?));
+                let meas: Vec<[f64; 2]> = input
+                    .loading
+                    .iter()
+                    .filter(|p| p[0] >= 0.0)
+                    .copied()
+                    .collect();
+                curve_worst =
+                    model.correct_shear_curve(|x| Some(interp(&meas, x)? - interp(&virgin, x)?));
             }
         } else if model.shear_is_kes() {
             let (g, h1, h5) = (
@@ -297,9 +324,11 @@ fn fit(
 /// simulated one, over the measured points the simulation covers (x ≥ 0).
 pub fn curve_rms_pct(measured: &[[f64; 2]], simulated: &[[f64; 2]]) -> Option<f64> {
     let pts: Vec<&[f64; 2]> = measured.iter().filter(|p| p[0] >= 0.0).collect();
-    let (lo, hi) = pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
-        (l.min(p[1]), h.max(p[1]))
-    });
+    let (lo, hi) = pts
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+            (l.min(p[1]), h.max(p[1]))
+        });
     let mut sim = simulated.to_vec();
     sim.sort_by(|a, b| a[0].total_cmp(&b[0]));
     let (mut sum, mut n) = (0.0, 0usize);
@@ -321,8 +350,7 @@ fn kes_units(p: KesParam, si: f64) -> (String, String, f64) {
 /// Runs the lab on one fabric.
 pub fn run_fabric(spec: &FabricSpec, opts: &LabOptions) -> Result<FabricReport, String> {
     let meas = measurements(spec);
-    let mut model =
-        LawModel::new(&meas).map_err(|e| format!("{}: {e}", display_path(spec)))?;
+    let mut model = LawModel::new(&meas).map_err(|e| format!("{}: {e}", display_path(spec)))?;
     let mut rounds = 0;
     if opts.fit && model.has_kes_modes() {
         let mesh = opts.meshes.first().map_or(RigMesh::COARSE, |m| m.1);
@@ -470,8 +498,18 @@ fn display_path(spec: &FabricSpec) -> String {
 fn axes(test: &str) -> (&'static str, &'static str, f64, f64) {
     match test {
         t if t.starts_with("tensile") => ("strain (%)", "force (gf/cm)", 100.0, 1.0 / 0.980665),
-        "shear" => ("shear angle (deg)", "shear force (gf/cm)", 180.0 / std::f64::consts::PI, 1.0 / 0.980665),
-        _ => ("curvature (1/cm)", "moment (gf·cm/cm)", 0.01, 1.0 / 9.80665e-3),
+        "shear" => (
+            "shear angle (deg)",
+            "shear force (gf/cm)",
+            180.0 / std::f64::consts::PI,
+            1.0 / 0.980665,
+        ),
+        _ => (
+            "curvature (1/cm)",
+            "moment (gf·cm/cm)",
+            0.01,
+            1.0 / 9.80665e-3,
+        ),
     }
 }
 
@@ -479,8 +517,18 @@ fn axes(test: &str) -> (&'static str, &'static str, f64, f64) {
 pub fn write_fabric_outputs(report: &FabricReport, dir: &Path) -> Result<Vec<PathBuf>, String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let mut written = Vec::new();
-    for test in ["tensile_warp", "tensile_weft", "shear", "bending_warp", "bending_weft"] {
-        if report.runs.iter().all(|(_, r)| test_path(r, test).path.is_empty()) {
+    for test in [
+        "tensile_warp",
+        "tensile_weft",
+        "shear",
+        "bending_warp",
+        "bending_weft",
+    ] {
+        if report
+            .runs
+            .iter()
+            .all(|(_, r)| test_path(r, test).path.is_empty())
+        {
             continue;
         }
         let (xl, yl, fx, fy) = axes(test);
@@ -543,8 +591,14 @@ pub fn write_summary(reports: &[FabricReport], dir: &Path) -> Result<(PathBuf, P
     md += "\n## Curves (RMS difference, % of the measured range)\n\n| fabric | test | mesh | RMS % |\n|---|---|---|---|\n";
     for r in reports {
         for c in &r.curves {
-            csv += &format!("{},{},{},curve_rms,%,,,{:.3}\n", r.name, c.test, c.mesh, c.rms_pct);
-            md += &format!("| {} | {} | {} | {:.2} |\n", r.name, c.test, c.mesh, c.rms_pct);
+            csv += &format!(
+                "{},{},{},curve_rms,%,,,{:.3}\n",
+                r.name, c.test, c.mesh, c.rms_pct
+            );
+            md += &format!(
+                "| {} | {} | {} | {:.2} |\n",
+                r.name, c.test, c.mesh, c.rms_pct
+            );
         }
     }
     md += "\n## Peirce cantilever (warp)\n\n| fabric | bending length (cm) | (B/W)^(1/3) (cm) | error % |\n|---|---|---|---|\n";

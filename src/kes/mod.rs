@@ -14,4 +14,6 @@ pub mod units;
 pub mod wang;
 
 pub use error::KesError;
-pub use fabric::{read_fabric, read_fabric_dir, write_fabric, Curve, FabricSpec, KesParam, KesValues};
+pub use fabric::{
+    read_fabric, read_fabric_dir, write_fabric, Curve, FabricSpec, KesParam, KesValues,
+};

@@ -191,7 +191,11 @@ mod tests {
         assert!(t.rt.is_none());
         // unloading at (1−μ)/(1+μ) of the loading ⇒ RT = (1−μ)/(1+μ)
         let r = 0.6;
-        let un: Vec<[f64; 2]> = load.iter().filter(|q| q[0] <= em).map(|q| [q[0], r * q[1]]).collect();
+        let un: Vec<[f64; 2]> = load
+            .iter()
+            .filter(|q| q[0] <= em)
+            .map(|q| [q[0], r * q[1]])
+            .collect();
         let t = tensile_parameters(&load, &un, fm).unwrap();
         assert!((t.rt.unwrap() - r).abs() < 2e-3, "{:?}", t.rt);
     }

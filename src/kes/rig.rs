@@ -208,9 +208,8 @@ fn sample(
     across_cells: Option<usize>,
 ) -> Result<(ClothModel, usize, usize), ClothError> {
     let na = ((along * 100.0 * mesh.cells_per_cm).round() as usize).max(4) + 1;
-    let nc = across_cells
-        .unwrap_or(((across * 100.0 * mesh.cells_per_cm).round() as usize).max(2))
-        + 1;
+    let nc =
+        across_cells.unwrap_or(((across * 100.0 * mesh.cells_per_cm).round() as usize).max(2)) + 1;
     let fabric = FabricParameters {
         density,
         stretch_damping: 0.0,
@@ -346,7 +345,8 @@ pub fn shear(
         };
     }
     qs.solve("shear test (tension)")?;
-    let stretched = gauge + top.iter().map(|&i| (qs.x[i] - x0[i]).dot(&ax)).sum::<f64>() / top.len() as f64;
+    let stretched =
+        gauge + top.iter().map(|&i| (qs.x[i] - x0[i]).dot(&ax)).sum::<f64>() / top.len() as f64;
     for phi in path {
         for &i in &top {
             // sideways position prescribed, free along the gauge (constant tension)

@@ -116,7 +116,10 @@ pub fn to_si(value: f64, unit: &str, q: Quantity) -> Result<f64, String> {
         .map(|(_, f)| value * f)
         .ok_or_else(|| {
             let ok: Vec<&str> = units_of(q).iter().map(|(n, _)| *n).collect();
-            format!("unit `{unit}` is not a unit of {q:?} (use one of {})", ok.join(", "))
+            format!(
+                "unit `{unit}` is not a unit of {q:?} (use one of {})",
+                ok.join(", ")
+            )
         })
 }
 

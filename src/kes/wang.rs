@@ -58,17 +58,24 @@ fn table(
     arr.iter()
         .enumerate()
         .map(|(i, r)| {
-            let r = r
-                .as_array()
-                .filter(|r| r.len() == cols)
-                .ok_or_else(|| field_err(file, &format!("{key}[{i}]"), format!("expected {cols} values")))?;
+            let r = r.as_array().filter(|r| r.len() == cols).ok_or_else(|| {
+                field_err(
+                    file,
+                    &format!("{key}[{i}]"),
+                    format!("expected {cols} values"),
+                )
+            })?;
             r.iter()
                 .enumerate()
                 .map(|(j, x)| {
                     x.as_f64()
                         .filter(|x| x.is_finite() && (*x >= 0.0 || signed.contains(&j)))
                         .ok_or_else(|| {
-                            field_err(file, &format!("{key}[{i}][{j}]"), "must be a finite number (≥ 0 for stiffnesses)")
+                            field_err(
+                                file,
+                                &format!("{key}[{i}][{j}]"),
+                                "must be a finite number (≥ 0 for stiffnesses)",
+                            )
                         })
                 })
                 .collect()

@@ -38,7 +38,10 @@ fn options(m: &Map) -> RResult<LabOptions> {
                 let names: Vec<String> = if let Some(a) = v.read_lock::<Array>() {
                     a.iter().map(|x| x.to_string()).collect()
                 } else {
-                    v.to_string().split(',').map(|s| s.trim().to_string()).collect()
+                    v.to_string()
+                        .split(',')
+                        .map(|s| s.trim().to_string())
+                        .collect()
                 };
                 o.meshes = names
                     .into_iter()
@@ -51,7 +54,11 @@ fn options(m: &Map) -> RResult<LabOptions> {
                     })
                     .collect::<RResult<_>>()?;
             }
-            "fit" => o.fit = v.as_bool().map_err(|_| rt_err("lab option `fit` must be a bool"))?,
+            "fit" => {
+                o.fit = v
+                    .as_bool()
+                    .map_err(|_| rt_err("lab option `fit` must be a bool"))?
+            }
             "cantilever" => {
                 o.cantilever = v
                     .as_bool()
@@ -61,7 +68,10 @@ fn options(m: &Map) -> RResult<LabOptions> {
                 let names: Vec<String> = if let Some(a) = v.read_lock::<Array>() {
                     a.iter().map(|x| x.to_string()).collect()
                 } else {
-                    v.to_string().split(',').map(|s| s.trim().to_string()).collect()
+                    v.to_string()
+                        .split(',')
+                        .map(|s| s.trim().to_string())
+                        .collect()
                 };
                 let mut t = Tests {
                     tensile: false,
@@ -73,11 +83,9 @@ fn options(m: &Map) -> RResult<LabOptions> {
                         "tensile" => t.tensile = true,
                         "shear" => t.shear = true,
                         "bending" => t.bending = true,
-                        _ => {
-                            return Err(rt_err(format!(
-                                "lab option `tests`: unknown test `{n}` (use tensile, shear, bending)"
-                            )))
-                        }
+                        _ => return Err(rt_err(format!(
+                            "lab option `tests`: unknown test `{n}` (use tensile, shear, bending)"
+                        ))),
                     }
                 }
                 o.tests = t;
@@ -119,7 +127,10 @@ pub fn register(engine: &mut Engine) {
         |path: &str| -> RResult<KesFabric> {
             Ok(KesFabric(Arc::new(read_fabric(Path::new(path)).map_err(rt_err)?)))
         });
-    register!(engine, "kes_fabrics", ["dir: String", "Array"],
+    register!(
+        engine,
+        "kes_fabrics",
+        ["dir: String", "Array"],
         "Reads every `*.json` fabric file of a folder, sorted by name.",
         |dir: &str| -> RResult<Array> {
             Ok(read_fabric_dir(Path::new(dir))
@@ -127,17 +138,30 @@ pub fn register(engine: &mut Engine) {
                 .into_iter()
                 .map(|f| Dynamic::from(KesFabric(Arc::new(f))))
                 .collect())
-        });
+        }
+    );
     register!(engine, "kes_import_wang", ["dir: String", "out_dir: String", "Array"],
         "Converts the Wang 2011 (ARCSim) material files of `dir` into fabric files in `out_dir`;\nreturns the written paths. (Their licence forbids redistribution: convert at run time.)",
         |dir: &str, out: &str| -> RResult<Array> {
             Ok(paths(wang::import_wang_dir(Path::new(dir), Path::new(out)).map_err(rt_err)?))
         });
-    register!(engine, "name", ["fabric: KesFabric", "String"],
-        "The fabric's name.", |f: &mut KesFabric| f.0.name.clone());
-    register!(engine, "to_string", ["fabric: KesFabric", "String"],
+    register!(
+        engine,
+        "name",
+        ["fabric: KesFabric", "String"],
+        "The fabric's name.",
+        |f: &mut KesFabric| f.0.name.clone()
+    );
+    register!(
+        engine,
+        "to_string",
+        ["fabric: KesFabric", "String"],
         "One-line summary of a fabric file.",
-        |f: &mut KesFabric| format!("KesFabric({}, {:.3} kg/m², {})", f.0.name, f.0.density, f.0.path));
+        |f: &mut KesFabric| format!(
+            "KesFabric({}, {:.3} kg/m², {})",
+            f.0.name, f.0.density, f.0.path
+        )
+    );
 
     register!(engine, "kes_lab", ["fabric: KesFabric", "options: Map", "KesReport"],
         "Runs the virtual Kawabata lab on a fabric: fits the law to its KES parameters (if any),\nruns the rigs and compares. Options: `meshes` (\"coarse\", \"fine\"), `fit` (bool),\n`cantilever` (bool), `tests` (\"tensile\", \"shear\", \"bending\"); defaults: both meshes,\nfit, cantilever, every test.",
@@ -163,9 +187,13 @@ pub fn register(engine: &mut Engine) {
     register!(engine, "worst_curve_rms_pct", ["report: KesReport", "float"],
         "The largest curve RMS difference of the report (% of the measured range; 0 without curves).",
         |r: &mut KesReport| r.0.worst_curve());
-    register!(engine, "worst_param_err_pct", ["report: KesReport", "float"],
+    register!(
+        engine,
+        "worst_param_err_pct",
+        ["report: KesReport", "float"],
         "The largest relative parameter error of the report (%).",
-        |r: &mut KesReport| r.0.worst_param());
+        |r: &mut KesReport| r.0.worst_param()
+    );
     register!(engine, "bending_length", ["report: KesReport", "Map"],
         "The Peirce cantilever result: #{simulated, theory} bending lengths (m), theory = (B/W)^(1/3);\nempty when the cantilever was not run.",
         |r: &mut KesReport| -> Map {
