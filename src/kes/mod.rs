@@ -7,6 +7,7 @@ pub mod calibrate;
 pub mod damping;
 pub mod error;
 pub mod fabric;
+pub mod fit;
 pub mod lab;
 pub mod parameters;
 pub mod rig;

@@ -83,9 +83,11 @@ fn options(m: &Map) -> RResult<LabOptions> {
                         "tensile" => t.tensile = true,
                         "shear" => t.shear = true,
                         "bending" => t.bending = true,
-                        _ => return Err(rt_err(format!(
+                        _ => {
+                            return Err(rt_err(format!(
                             "lab option `tests`: unknown test `{n}` (use tensile, shear, bending)"
-                        ))),
+                        )))
+                        }
                     }
                 }
                 o.tests = t;
