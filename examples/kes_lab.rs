@@ -30,10 +30,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     for c in &r.curves {
-        println!("{:14} {:6} curve RMS {:.2} % of range", c.test, c.mesh, c.rms_pct);
+        println!(
+            "{:14} {:6} curve RMS {:.2} % of range",
+            c.test, c.mesh, c.rms_pct
+        );
     }
     if let Some((s, t)) = r.bending_length {
-        println!("Peirce bending length {:.3} cm, (B/W)^(1/3) {:.3} cm", s * 100.0, t * 100.0);
+        println!(
+            "Peirce bending length {:.3} cm, (B/W)^(1/3) {:.3} cm",
+            s * 100.0,
+            t * 100.0
+        );
     }
     let out = Path::new("out/kes_lab");
     let files = lab::write_fabric_outputs(&r, out)?;

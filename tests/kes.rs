@@ -11,7 +11,10 @@ use emilion::kes::units::{self, to_si, Quantity};
 use emilion::kes::{lab, read_fabric, rig, wang, write_fabric, KesParam};
 
 fn wang_dir() -> PathBuf {
-    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/fabrics/wang2011"))
+    PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../shared/data/fabrics/wang2011"
+    ))
 }
 
 fn repo(p: &str) -> PathBuf {
@@ -46,9 +49,17 @@ fn each_kes_conversion_has_its_factor() {
         assert!(close(si, factor, 1e-5), "{unit}: {si} vs {factor}");
     }
     // 10 mg/cm² = 100 g/m²
-    assert!(close(to_si(10.0, "mg/cm2", Quantity::ArealWeight).unwrap(), 0.1, 1e-12));
+    assert!(close(
+        to_si(10.0, "mg/cm2", Quantity::ArealWeight).unwrap(),
+        0.1,
+        1e-12
+    ));
     // the exact shear factor is 0.980665 · 180/π
-    assert!(close(units::GF_PER_CM_DEG, 0.980665 * 180.0 / std::f64::consts::PI, 1e-12));
+    assert!(close(
+        units::GF_PER_CM_DEG,
+        0.980665 * 180.0 / std::f64::consts::PI,
+        1e-12
+    ));
     // a unit of another quantity is refused
     assert!(to_si(1.0, "gf/cm", Quantity::BendingRigidity).is_err());
     // and the way back
@@ -80,15 +91,33 @@ fn fabric_files_round_trip_in_kes_units() {
     let spec = read_fabric(&repo("kawabata/fabrics/suiting-hesc.json")).unwrap();
     assert!(close(spec.density, 0.22, 1e-12));
     assert!(close(spec.warp.get(KesParam::Emt).unwrap(), 0.047, 1e-12));
-    assert!(close(spec.warp.get(KesParam::B).unwrap(), 0.10 * 9.80665e-5, 1e-12));
+    assert!(close(
+        spec.warp.get(KesParam::B).unwrap(),
+        0.10 * 9.80665e-5,
+        1e-12
+    ));
     let dir = std::env::temp_dir().join(format!("emilion-fabric-{}", std::process::id()));
     let out = dir.join("copy.json");
     write_fabric(&out, &spec).unwrap();
     let back = read_fabric(&out).unwrap();
-    for p in [KesParam::Emt, KesParam::Lt, KesParam::Rt, KesParam::G, KesParam::Hg52, KesParam::B, KesParam::Hb2] {
-        assert!(close(back.warp.get(p).unwrap(), spec.warp.get(p).unwrap(), 1e-12), "{p:?}");
+    for p in [
+        KesParam::Emt,
+        KesParam::Lt,
+        KesParam::Rt,
+        KesParam::G,
+        KesParam::Hg52,
+        KesParam::B,
+        KesParam::Hb2,
+    ] {
+        assert!(
+            close(back.warp.get(p).unwrap(), spec.warp.get(p).unwrap(), 1e-12),
+            "{p:?}"
+        );
     }
-    assert!(parse_fabric("{\"format\": \"x\"}", "t.json").unwrap_err().to_string().contains("format"));
+    assert!(parse_fabric("{\"format\": \"x\"}", "t.json")
+        .unwrap_err()
+        .to_string()
+        .contains("format"));
     std::fs::remove_dir_all(dir).ok();
 }
 
@@ -117,7 +146,10 @@ fn wang_fabrics_import_with_their_tables() {
     let s = denim.curves.shear.as_ref().unwrap().loading.last().unwrap();
     let phi = 8f64.to_radians();
     let c33 = 53.387184 + (83.992020 - 53.387184) * (3.0 * phi);
-    assert!(close(s[1], 0.5 * c33 * phi + 9.80665 * phi.tan(), 1e-6), "{s:?}");
+    assert!(
+        close(s[1], 0.5 * c33 * phi + 9.80665 * phi.tan(), 1e-6),
+        "{s:?}"
+    );
     std::fs::remove_dir_all(out).ok();
 }
 
@@ -134,10 +166,23 @@ fn rigs_recover_kes_parameters_within_5_percent() {
         assert!(names.contains(&want), "{want} not compared");
     }
     for p in &r.params {
-        assert!(p.error_pct.abs() <= 5.0, "{} {} {}: {:.3} vs {:.3} ({:+.2} %)", p.test, p.mesh, p.param, p.simulated, p.measured, p.error_pct);
+        assert!(
+            p.error_pct.abs() <= 5.0,
+            "{} {} {}: {:.3} vs {:.3} ({:+.2} %)",
+            p.test,
+            p.mesh,
+            p.param,
+            p.simulated,
+            p.measured,
+            p.error_pct
+        );
     }
     // the loops are really there: widths measured from simulated loops are not zero
-    let hb = r.params.iter().find(|p| p.param == "2HB" && p.mesh == "fine").unwrap();
+    let hb = r
+        .params
+        .iter()
+        .find(|p| p.param == "2HB" && p.mesh == "fine")
+        .unwrap();
     assert!(hb.simulated > 0.5 * hb.measured);
 }
 
@@ -157,7 +202,13 @@ fn wang_curves_round_trip_on_coarse_and_fine_meshes() {
         let r = lab::run_fabric(&spec, &opts).unwrap();
         assert_eq!(r.curves.len(), 10, "{name}: 5 curves × 2 meshes");
         for c in &r.curves {
-            assert!(c.rms_pct <= 3.0, "{name} {} {}: {:.2} %", c.test, c.mesh, c.rms_pct);
+            assert!(
+                c.rms_pct <= 3.0,
+                "{name} {} {}: {:.2} %",
+                c.test,
+                c.mesh,
+                c.rms_pct
+            );
         }
     }
 }
@@ -175,7 +226,10 @@ fn peirce_cantilever_gives_the_bending_length() {
     });
     let theory = (b / (w * 9.81)).cbrt();
     let c = rig::bending_length(law, w, Direction::Warp, theory).unwrap();
-    assert!(close(c, theory, 0.03), "c = {c} m vs (B/W)^(1/3) = {theory} m");
+    assert!(
+        close(c, theory, 0.03),
+        "c = {c} m vs (B/W)^(1/3) = {theory} m"
+    );
 }
 
 #[test]
@@ -192,6 +246,12 @@ fn damping_fit_recovers_stretch_damping() {
         stretch_damping: 0.0,
         ..fab
     };
-    let (beta, _) = fit_stretch_damping(undamped, law, DecayExperiment::default(), target.log_decrement).unwrap();
+    let (beta, _) = fit_stretch_damping(
+        undamped,
+        law,
+        DecayExperiment::default(),
+        target.log_decrement,
+    )
+    .unwrap();
     assert!(close(beta, 3e-5, 0.05), "β = {beta}");
 }

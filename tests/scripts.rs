@@ -257,7 +257,13 @@ fn lab_scripts_run_and_write_plots() {
         assert!(stdout.contains("measured"), "{name}: {stdout}");
         let pngs = std::fs::read_dir(&out)
             .unwrap()
-            .filter(|e| e.as_ref().unwrap().path().extension().is_some_and(|x| x == "png"))
+            .filter(|e| {
+                e.as_ref()
+                    .unwrap()
+                    .path()
+                    .extension()
+                    .is_some_and(|x| x == "png")
+            })
             .count();
         assert!(pngs >= 1, "{name}: no plot in {}", out.display());
     }
@@ -271,14 +277,22 @@ fn lab_all_script_ends_with_the_summary_line() {
     let stdout = run_lab_script(
         "all",
         &[
-            ("fabrics", root().join("tests/data/fabrics_small").display().to_string()),
+            (
+                "fabrics",
+                root()
+                    .join("tests/data/fabrics_small")
+                    .display()
+                    .to_string(),
+            ),
             ("out", out.display().to_string()),
             ("meshes", "coarse".into()),
         ],
     );
     let last = stdout.lines().last().unwrap_or("");
     assert!(
-        last.starts_with("worst_curve_rms_pct=") && last.contains(" worst_param_err_pct=") && last.ends_with(" fabrics=1"),
+        last.starts_with("worst_curve_rms_pct=")
+            && last.contains(" worst_param_err_pct=")
+            && last.ends_with(" fabrics=1"),
         "{last}"
     );
     assert!(out.join("summary.csv").exists() && out.join("summary.md").exists());
