@@ -87,6 +87,18 @@ fn bad_fabric_files_name_file_and_field() {
 }
 
 #[test]
+fn a_fabric_without_a_usable_law_is_an_error_not_a_panic() {
+    // EMT = 0 is a valid number but no tensile law: the lab names the file and the field
+    let path = repo("tests/data/fabrics_bad/zero_emt.json");
+    let spec = read_fabric(&path).unwrap();
+    let err = lab::run_fabric(&spec, &lab::LabOptions::default()).unwrap_err();
+    assert!(
+        err.contains("zero_emt.json") && err.contains("kes.warp.EMT"),
+        "{err}"
+    );
+}
+
+#[test]
 fn fabric_files_round_trip_in_kes_units() {
     let spec = read_fabric(&repo("kawabata/fabrics/suiting-hesc.json")).unwrap();
     assert!(close(spec.density, 0.22, 1e-12));

@@ -85,9 +85,15 @@ impl ResponseCurve {
         Ok(ResponseCurve { xs, ys, ds, ws })
     }
 
-    /// A straight line y = slope · x.
+    /// A straight line y = slope · x (a non-finite slope gives the zero line).
     pub fn linear(slope: f64) -> Self {
-        ResponseCurve::new(&[[1.0, slope]]).expect("finite line")
+        let slope = if slope.is_finite() { slope } else { 0.0 };
+        ResponseCurve {
+            xs: vec![0.0, 1.0],
+            ys: vec![0.0, slope],
+            ds: vec![slope, slope],
+            ws: vec![0.0, 0.5 * slope],
+        }
     }
 
     /// (y, dy/dx, ∫₀ˣ y) at x ≥ 0.

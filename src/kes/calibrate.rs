@@ -78,6 +78,15 @@ pub struct BendingModel {
     pub hb: f64,
 }
 
+fn secant_of(fm: f64, em: f64) -> f64 {
+    let s = fm / em;
+    if s.is_finite() {
+        s
+    } else {
+        0.0
+    }
+}
+
 /// Builds the elastic tension curve and friction of a KES power-law model.
 fn kes_tension(fm: f64, em: f64, lt: f64, rt: f64) -> (ResponseCurve, f64, Option<Friction>) {
     let p = (2.0 / lt.clamp(0.05, 1.0) - 1.0).max(1.0);
@@ -88,7 +97,9 @@ fn kes_tension(fm: f64, em: f64, lt: f64, rt: f64) -> (ResponseCurve, f64, Optio
             [e, fm * (e / em).powf(p) / (1.0 + mu)]
         })
         .collect();
-    let curve = ResponseCurve::new(&pts).expect("finite power law");
+    // em > 0 and Fm > 0 are checked when the model is built, so the points are finite
+    let curve =
+        ResponseCurve::new(&pts).unwrap_or_else(|_| ResponseCurve::linear(secant_of(fm, em)));
     let secant = fm / em;
     let fr = (mu > 0.0).then_some(Friction {
         stick: 30.0 * secant,
@@ -216,6 +227,12 @@ impl LawModel {
                 tension_curves[d] = Some(curve);
                 tension[d] = TensileModel::Curve { mu };
             } else if let (Some(emt), lt, rt) = m.tensile_kes[d] {
+                if emt <= 0.0 {
+                    return Err(format!(
+                        "kes.{}.EMT must be > 0 to build a tensile law, got {emt}",
+                        names[d]
+                    ));
+                }
                 tension[d] = TensileModel::Kes {
                     em: emt,
                     lt: lt.unwrap_or(1.0),

@@ -39,7 +39,9 @@ pub fn fit(
         for (d, test) in ["tensile_warp", "tensile_weft"].iter().enumerate() {
             if let TensileModel::Kes { em, lt, rt } = &mut model.tension[d] {
                 if let Some((t, s)) = err(test, KesParam::Emt) {
-                    *em *= t / s;
+                    if s > 0.0 {
+                        *em *= t / s;
+                    }
                 }
                 if let Some((t, s)) = err(test, KesParam::Lt) {
                     *lt = (*lt + t - s).clamp(0.05, 1.0);
