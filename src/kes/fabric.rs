@@ -503,8 +503,8 @@ pub fn read_fabric(path: &Path) -> Result<FabricSpec, KesError> {
     parse_fabric(&text, &file)
 }
 
-/// Reads every `*.json` fabric of `dir`, sorted by file name.
-pub fn read_fabric_dir(dir: &Path) -> Result<Vec<FabricSpec>, KesError> {
+/// The `*.json` files of `dir`, sorted by name.
+pub fn json_files(dir: &Path) -> Result<Vec<PathBuf>, KesError> {
     let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
         .map_err(|e| KesError::Io {
             file: dir.display().to_string(),
@@ -514,7 +514,12 @@ pub fn read_fabric_dir(dir: &Path) -> Result<Vec<FabricSpec>, KesError> {
         .filter(|p| p.extension().is_some_and(|x| x == "json"))
         .collect();
     files.sort();
-    files.iter().map(|p| read_fabric(p)).collect()
+    Ok(files)
+}
+
+/// Reads every `*.json` fabric of `dir`, sorted by file name.
+pub fn read_fabric_dir(dir: &Path) -> Result<Vec<FabricSpec>, KesError> {
+    json_files(dir)?.iter().map(|p| read_fabric(p)).collect()
 }
 
 fn quantity_json(si: f64, q: Quantity) -> Value {

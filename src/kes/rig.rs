@@ -225,6 +225,15 @@ fn sample(
     Ok((model, na, nc))
 }
 
+/// The KES cycle 0 → +a → −a → +a in `steps` increments per amplitude.
+fn cycle(a: f64, steps: usize) -> Vec<f64> {
+    let d = a / steps as f64;
+    let mut path: Vec<f64> = (0..=steps).map(|k| k as f64 * d).collect();
+    path.extend((1..=2 * steps).map(|k| a - k as f64 * d));
+    path.extend((1..=2 * steps).map(|k| -a + k as f64 * d));
+    path
+}
+
 /// Particle index of (a along, c across) for a sample of `na` × `nc` along `dir`.
 fn pid(dir: Direction, na: usize, nc: usize, a: usize, c: usize) -> usize {
     match dir {
@@ -329,12 +338,7 @@ pub fn shear(
         qs.ext[top[c]] = ax * (tension * share);
     }
     qs.filter.any = true;
-    let steps = 24usize;
-    let dphi = amplitude / steps as f64;
-    let mut path: Vec<f64> = Vec::new();
-    path.extend((0..=steps).map(|k| k as f64 * dphi));
-    path.extend((1..=2 * steps).map(|k| amplitude - k as f64 * dphi));
-    path.extend((1..=2 * steps).map(|k| -amplitude + k as f64 * dphi));
+    let path = cycle(amplitude, 24);
     let mut curve = RigCurve::default();
     // the shear angle is measured on the gauge length under the test's tension (a stretchy
     // knit lengthens noticeably under 10 gf/cm)
@@ -403,12 +407,7 @@ pub fn bending(
     let right: Vec<usize> = (0..nc)
         .flat_map(|c| [pid(dir, na, nc, na - 2, c), pid(dir, na, nc, na - 1, c)])
         .collect();
-    let steps = 50usize;
-    let dk = amplitude / steps as f64;
-    let mut path: Vec<f64> = Vec::new();
-    path.extend((0..=steps).map(|k| k as f64 * dk));
-    path.extend((1..=2 * steps).map(|k| amplitude - k as f64 * dk));
-    path.extend((1..=2 * steps).map(|k| -amplitude + k as f64 * dk));
+    let path = cycle(amplitude, 50);
     let mut curve = RigCurve::default();
     qs.filter.any = true;
     // the moving clamp's tangent at the end of the arc: it may slide along it, so the strip

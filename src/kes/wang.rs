@@ -29,7 +29,7 @@ use serde_json::Value;
 
 use super::calibrate::SHEAR_TENSION;
 use super::error::KesError;
-use super::fabric::{write_fabric, Curve, FabricCurves, FabricSpec, KesValues};
+use super::fabric::{json_files, write_fabric, Curve, FabricCurves, FabricSpec, KesValues};
 
 fn field_err(file: &str, field: &str, message: impl Into<String>) -> KesError {
     KesError::Field {
@@ -192,15 +192,7 @@ pub fn import_wang(path: &Path) -> Result<FabricSpec, KesError> {
 /// Converts every `*.json` material of `dir` into our format under `out_dir` (same stems);
 /// returns the written paths, sorted.
 pub fn import_wang_dir(dir: &Path, out_dir: &Path) -> Result<Vec<PathBuf>, KesError> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map_err(|e| KesError::Io {
-            file: dir.display().to_string(),
-            message: e.to_string(),
-        })?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "json"))
-        .collect();
-    files.sort();
+    let files = json_files(dir)?;
     let mut out = Vec::new();
     for f in files {
         let spec = import_wang(&f)?;

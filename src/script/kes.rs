@@ -30,19 +30,24 @@ fn paths(v: Vec<PathBuf>) -> Array {
         .collect()
 }
 
+/// An array of strings, or one comma-separated string, as a list.
+fn string_list(v: &Dynamic) -> Vec<String> {
+    if let Some(a) = v.read_lock::<Array>() {
+        a.iter().map(|x| x.to_string()).collect()
+    } else {
+        v.to_string()
+            .split(',')
+            .map(|s| s.trim().to_string())
+            .collect()
+    }
+}
+
 fn options(m: &Map) -> RResult<LabOptions> {
     let mut o = LabOptions::default();
     for (k, v) in m {
         match k.as_str() {
             "meshes" => {
-                let names: Vec<String> = if let Some(a) = v.read_lock::<Array>() {
-                    a.iter().map(|x| x.to_string()).collect()
-                } else {
-                    v.to_string()
-                        .split(',')
-                        .map(|s| s.trim().to_string())
-                        .collect()
-                };
+                let names = string_list(v);
                 o.meshes = names
                     .into_iter()
                     .map(|n| match n.as_str() {
@@ -65,14 +70,7 @@ fn options(m: &Map) -> RResult<LabOptions> {
                     .map_err(|_| rt_err("lab option `cantilever` must be a bool"))?
             }
             "tests" => {
-                let names: Vec<String> = if let Some(a) = v.read_lock::<Array>() {
-                    a.iter().map(|x| x.to_string()).collect()
-                } else {
-                    v.to_string()
-                        .split(',')
-                        .map(|s| s.trim().to_string())
-                        .collect()
-                };
+                let names = string_list(v);
                 let mut t = Tests {
                     tensile: false,
                     shear: false,
