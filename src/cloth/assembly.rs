@@ -549,12 +549,6 @@ impl Assembly {
 }
 
 impl Assembly {
-    /// Friction states (committed coordinate, friction force per width) of the springs; empty
-    /// when the law has no friction.
-    pub fn spring_friction(&self) -> &[[f64; 2]] {
-        &self.fric_spring
-    }
-
     /// Makes the friction states of the last evaluation the committed ones.
     pub fn commit_friction(&mut self) {
         self.fric_spring.copy_from_slice(&self.trial_spring);

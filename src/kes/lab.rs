@@ -99,6 +99,18 @@ impl FabricReport {
     pub fn worst_curve(&self) -> f64 {
         self.curves.iter().map(|c| c.rms_pct).fold(0.0, f64::max)
     }
+    /// Rig increments, over all runs, whose equilibrium stopped at the iteration cap.
+    pub fn unconverged(&self) -> usize {
+        self.runs
+            .iter()
+            .map(|(_, r)| {
+                r.tensile.iter().map(|c| c.unconverged).sum::<usize>()
+                    + r.shear.unconverged
+                    + r.bending.iter().map(|c| c.unconverged).sum::<usize>()
+            })
+            .sum()
+    }
+
     /// Largest parameter error (%).
     pub fn worst_param(&self) -> f64 {
         self.params
@@ -527,6 +539,10 @@ pub fn write_summary(reports: &[FabricReport], dir: &Path) -> Result<(PathBuf, P
                 100.0 * (s - t) / t
             );
         }
+    }
+    md += "\n## Equilibrium\n\nRig increments whose Newton iterations stopped at the cap before a relative force residual of 1e-6:\n\n| fabric | increments |\n|---|---|\n";
+    for r in reports {
+        md += &format!("| {} | {} |\n", r.name, r.unconverged());
     }
     let (pc, pm) = (dir.join("summary.csv"), dir.join("summary.md"));
     std::fs::write(&pc, csv).map_err(|e| format!("{}: {e}", pc.display()))?;
