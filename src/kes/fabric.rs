@@ -272,7 +272,7 @@ impl Reader<'_> {
         if !value.is_finite() {
             return Err(self.err(field, format!("value {value} is not finite")));
         }
-        units::to_si(value, unit, q).map_err(|e| self.err(&format!("{field}.unit"), e))
+        units::to_si(value, unit, q).map_err(|e| self.err(&format!("{field}.unit"), e.to_string()))
     }
 
     fn non_negative(&self, v: f64, field: &str) -> Result<f64, KesError> {
@@ -325,7 +325,9 @@ impl Reader<'_> {
                 .ok_or_else(|| self.err(&f, "missing"))?
                 .as_str()
                 .ok_or_else(|| self.err(&f, "must be a string"))?;
-            units::to_si(1.0, u, q).map_err(|e| self.err(&f, e))
+            units::unit_for(u, q)
+                .map(|u| u.factor())
+                .map_err(|e| self.err(&f, e.to_string()))
         };
         let (fx, fy) = (unit("x_unit", qx)?, unit("y_unit", qy)?);
         let loading = self.points(
@@ -350,6 +352,12 @@ impl Reader<'_> {
             Some(u) => self.points(u, &format!("{field}.unloading"), fx, fy)?,
             None => Vec::new(),
         };
+        if unloading.len() == 1 {
+            return Err(self.err(
+                &format!("{field}.unloading"),
+                "needs at least 2 points (or leave it out)",
+            ));
+        }
         Ok(Curve { loading, unloading })
     }
 }
@@ -511,7 +519,7 @@ pub fn json_files(dir: &Path) -> Result<Vec<PathBuf>, KesError> {
             message: e.to_string(),
         })?
         .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "json"))
+        .filter(|p| p.is_file() && p.extension().is_some_and(|x| x == "json"))
         .collect();
     files.sort();
     Ok(files)
@@ -523,11 +531,12 @@ pub fn read_fabric_dir(dir: &Path) -> Result<Vec<FabricSpec>, KesError> {
 }
 
 fn quantity_json(si: f64, q: Quantity) -> Value {
-    let (unit, f) = units::kes_unit(q);
-    json!({"value": si * f, "unit": unit})
+    let u = q.kes_unit();
+    json!({"value": u.from_si(si), "unit": u.symbol()})
 }
 
-/// The fabric as JSON in KES units.
+/// The fabric as JSON in KES units (a non-finite number becomes `null`, which
+/// [`parse_fabric`] refuses).
 pub fn fabric_to_json(spec: &FabricSpec) -> Value {
     let mut root = Map::new();
     root.insert("format".into(), json!(FORMAT));
@@ -558,13 +567,17 @@ pub fn fabric_to_json(spec: &FabricSpec) -> Value {
     let mut curves = Map::new();
     for (k, (key, qx, qy)) in CURVES.iter().enumerate() {
         if let Some(c) = spec.curves.slot(k) {
-            let ((ux, fx), (uy, fy)) = (units::kes_unit(*qx), units::kes_unit(*qy));
+            let (ux, uy) = (qx.kes_unit(), qy.kes_unit());
             let pts = |v: &[[f64; 2]]| -> Value {
-                Value::Array(v.iter().map(|p| json!([p[0] * fx, p[1] * fy])).collect())
+                Value::Array(
+                    v.iter()
+                        .map(|p| json!([ux.from_si(p[0]), uy.from_si(p[1])]))
+                        .collect(),
+                )
             };
             let mut m = Map::new();
-            m.insert("x_unit".into(), json!(ux));
-            m.insert("y_unit".into(), json!(uy));
+            m.insert("x_unit".into(), json!(ux.symbol()));
+            m.insert("y_unit".into(), json!(uy.symbol()));
             m.insert("loading".into(), pts(&c.loading));
             if !c.unloading.is_empty() {
                 m.insert("unloading".into(), pts(&c.unloading));
@@ -582,13 +595,22 @@ pub fn fabric_to_json(spec: &FabricSpec) -> Value {
     Value::Object(root)
 }
 
-/// Writes a fabric file in KES units (atomically).
+/// Writes a fabric file in KES units (gf/cm, %, deg, 1/cm, gf.cm/cm, mg/cm2, …), atomically
+/// (a temporary file renamed into place). The text is checked with [`parse_fabric`] before
+/// anything is written, so a spec that could not be read back (a negative stiffness, a NaN,
+/// a loading branch going back) is an error naming `path` and the field, and reading the
+/// written file gives the same spec (values equal to rounding, `path` the new file).
 pub fn write_fabric(path: &Path, spec: &FabricSpec) -> Result<(), KesError> {
-    let text = serde_json::to_string_pretty(&fabric_to_json(spec)).expect("JSON of finite values");
+    let file = path.display().to_string();
     let io = |e: std::io::Error| KesError::Io {
-        file: path.display().to_string(),
+        file: file.clone(),
         message: e.to_string(),
     };
+    let text = serde_json::to_string_pretty(&fabric_to_json(spec)).map_err(|e| KesError::Io {
+        file: file.clone(),
+        message: e.to_string(),
+    })?;
+    parse_fabric(&text, &file)?;
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).map_err(io)?;
     }

@@ -16,5 +16,12 @@ pub mod wang;
 
 pub use error::KesError;
 pub use fabric::{
-    read_fabric, read_fabric_dir, write_fabric, Curve, FabricSpec, KesParam, KesValues,
+    read_fabric, read_fabric_dir, write_fabric, Curve, FabricCurves, FabricSpec, KesParam,
+    KesValues,
 };
+pub use parameters::{
+    bending_parameters, shear_parameters, split_branches, tensile_parameters, BendingParams,
+    ShearParams, TensileParams,
+};
+pub use units::{Quantity, Unit, UnitError};
+pub use wang::{import_wang, import_wang_dir};

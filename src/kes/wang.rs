@@ -14,8 +14,13 @@
 //! Conversion (documented in every file's provenance):
 //! - tensile (strip-biaxial, width held): k(ε) = 2·lerp(c_row0, c_row, min(6ε, 1)),
 //!   F(ε) = (1 + ε) k(ε) (ε + ε²/2), ε = 0 … 1/6 every 0.5 % (warp: c11, row 1; weft: c22, row 5);
+//! - tensile along the bias (45°, row 3): the deformation F = I + ε d dᵀ, d = (1, 1)/√2, has
+//!   Green strain G = e d dᵀ with e = ε + ε²/2, so G_uu = G_vv = G_uv = e/2 and
+//!   W = (e²/8)(k0 + k2 + 2 k1 + k3); the force per width along d is ∂W/∂ε (stiffnesses held,
+//!   as ARCSim's forces do): F(ε) = (1 + ε) (e/4)(k0 + k2 + 2 k1 + k3), each k_i =
+//!   2·lerp(c_row0, c_row3, min(6ε, 1)) — small-strain slope (c11 + c22 + 2 c12 + c33)/2;
 //! - shear as the KES-FB1 instrument would read it under its 10 gf/cm tension:
-//!   H(φ) = (c33(φ)/2) φ + W tan φ, c33(φ) = lerp(c33_row0, c33_row3, min(3|φ|, 1)),
+//!   H(φ) = (c33(φ)/2) φ + T tan φ (T = 10 gf/cm), c33(φ) = lerp(c33_row0, c33_row3, min(3|φ|, 1)),
 //!   0 … 8° every 0.5°;
 //! - bending: M(κ) = k(κ) κ with k interpolated along the row, 0 … 0.4 1/cm every 0.025 1/cm;
 //!   curvature along the warp bends about hinges at 90° from u (row 2), along the weft row 0,
@@ -83,6 +88,24 @@ fn table(
         .collect()
 }
 
+/// The conversion, as written into every converted file's provenance.
+pub const CONVERSION: &str = "u taken as the warp (the files do not say). Weight = density. \
+    Tensile (strip-biaxial, width held, ARCSim Green-strain model): \
+    k(e) = 2 lerp(c_row0, c_row, min(6e, 1)), F = (1+e) k(e) (e + e^2/2) N/m, \
+    warp c11 with row 1 (0 deg), weft c22 with row 5 (90 deg), e = 0 to 1/6 every 0.5 %, \
+    loading only (elastic data). Bias (45 deg, row 3, deformation I + e d d^T, d = (1,1)/sqrt 2, \
+    W = (e + e^2/2)^2 (k11 + k22 + 2 k12 + k33)/8, F = dW/de): \
+    F = (1+e) (e + e^2/2) (k11 + k22 + 2 k12 + k33)/4, k = 2 lerp(c_row0, c_row3, min(6e, 1)). \
+    Tensile Fm = the larger end force of warp and weft. \
+    Shear as read by the KES-FB1 under its 10 gf/cm clamp tension: \
+    H = (c33(phi)/2) phi + 10 gf/cm tan(phi), c33(phi) = lerp(c33_row0, c33_row3, min(3|phi|, 1)) \
+    (c33/2 = ARCSim's engineering shear stiffness, G_uv = phi/2), 0 to 8 deg every 0.5 deg. \
+    Bending: M = k(kappa) kappa, k linear in kappa between the columns (0, 10, 20, 30, 40 1/m), \
+    every 0.025 1/cm to 0.4 1/cm or to where M stops rising; warp = row 2 (hinge edge at 90 deg), \
+    weft = row 0, bias = row 1; ARCSim's hinge normalisation makes the table value the bending \
+    rigidity within ~25 % (maths notes 2.1), we take it as B. \
+    No KES parameters: they are computed from the curves.";
+
 fn lerp(a: f64, b: f64, t: f64) -> f64 {
     a + (b - a) * t
 }
@@ -107,10 +130,11 @@ pub fn import_wang(path: &Path) -> Result<FabricSpec, KesError> {
         .ok_or_else(|| field_err(&file, "density", "expected a positive number"))?;
     let st = table(&v, &file, "stretching", 6, 4, &[0, 1, 2, 3])?;
     let bend = table(&v, &file, "bending", 3, 5, &[])?;
+    // ε = 0, 0.5 %, … 16.5 %, 1/6
+    let strains = || (0..=34).map(|k| (k as f64 * 0.005).min(1.0 / 6.0));
     let tensile = |col: usize, row: usize| -> Curve {
-        let loading = (0..=34)
-            .map(|k| {
-                let e = (k as f64 * 0.005).min(1.0 / 6.0);
+        let loading = strains()
+            .map(|e| {
                 let kk = 2.0 * lerp(st[0][col], st[row][col], (6.0 * e).min(1.0));
                 [e, (1.0 + e) * kk * (e + 0.5 * e * e)]
             })
@@ -153,22 +177,43 @@ pub fn import_wang(path: &Path) -> Result<FabricSpec, KesError> {
     };
     let warp = tensile(0, 1);
     let weft = tensile(2, 5);
-    let fm = warp.loading.last().unwrap()[1].max(weft.loading.last().unwrap()[1]);
+    let bias = Curve {
+        loading: strains()
+            .map(|e| {
+                let t = (6.0 * e).min(1.0);
+                let k: f64 = (0..4)
+                    .map(|c| {
+                        let w = if c == 1 { 2.0 } else { 1.0 };
+                        w * 2.0 * lerp(st[0][c], st[3][c], t)
+                    })
+                    .sum();
+                [e, (1.0 + e) * 0.25 * k * (e + 0.5 * e * e)]
+            })
+            .collect(),
+        unloading: Vec::new(),
+    };
+    let end = |c: &Curve| c.loading.last().map_or(0.0, |p| p[1]);
+    let fm = end(&warp).max(end(&weft));
+    if !(fm.is_finite() && fm > 0.0) {
+        return Err(field_err(
+            &file,
+            "stretching",
+            "the warp and weft tables give no tensile force at 1/6 strain",
+        ));
+    }
     let name = path
         .file_stem()
         .map(|s| s.to_string_lossy().to_string())
         .unwrap_or_default();
     Ok(FabricSpec {
-        description: format!("{name}: measured by Wang, O'Brien & Ramamoorthi 2011 (ARCSim material)"),
+        description: format!(
+            "{name}: measured by Wang, O'Brien & Ramamoorthi 2011 (ARCSim material)"
+        ),
         provenance: format!(
-            "Converted at run time from {file} (Wang, O'Brien, Ramamoorthi, \"Data-Driven Elastic Models for Cloth\", \
-             ACM TOG 30(4):71, 2011, doi 10.1145/2010324.1964966; ARCSim licence: educational, research and \
-             not-for-profit use, not redistributed). u taken as the warp. Tensile (width held): \
-             k(e) = 2 lerp(c_row0, c_row, min(6e,1)), F = (1+e) k(e) (e + e^2/2), warp c11/row 1, weft c22/row 5, \
-             to e = 1/6. Shear as read by KES-FB1 under 10 gf/cm: H = (c33(phi)/2) phi + W tan(phi), \
-             c33 = lerp(row0, row3, min(3|phi|,1)), to 8 deg. Bending: M = k(kappa) kappa, warp = row 2 \
-             (hinge at 90 deg), weft = row 0, bias = row 1, to 0.4 1/cm or where M stops rising; table value taken as B (ARCSim's \
-             hinge normalisation: within ~25 %). No KES parameters: they are computed from the curves."
+            "Converted at run time from {file} (Wang, O'Brien, Ramamoorthi, \"Data-Driven \
+             Elastic Models for Cloth\", ACM TOG 30(4):71, 2011, doi 10.1145/2010324.1964966; \
+             ARCSim licence: educational, research and not-for-profit use; converted at run \
+             time, not redistributed). {CONVERSION}"
         ),
         name,
         path: file.clone(),
@@ -179,7 +224,7 @@ pub fn import_wang(path: &Path) -> Result<FabricSpec, KesError> {
         curves: FabricCurves {
             tensile_warp: Some(warp),
             tensile_weft: Some(weft),
-            tensile_bias: None,
+            tensile_bias: Some(bias),
             shear: Some(shear),
             bending_warp: Some(bending(2)),
             bending_weft: Some(bending(0)),
