@@ -19,6 +19,7 @@ use std::sync::Arc;
 
 use crate::cloth::{ClothError, Direction, Friction, MaterialLaw, MeasuredLaw, ResponseCurve};
 
+use super::parameters::interp;
 use super::rig::{self, RigCurve, RigMesh};
 
 /// The standard test conditions (SI), adapted to the range a fabric's curves cover.
@@ -130,23 +131,6 @@ fn loop_split(loading: &[[f64; 2]], unloading: &[[f64; 2]]) -> (Vec<[f64; 2]>, f
     }
     let mu = if den > 0.0 { num / den } else { 0.0 };
     (mean, mu.clamp(0.0, 0.95))
-}
-
-/// Linear interpolation of a branch sorted by x; None outside its range.
-pub fn interp(branch: &[[f64; 2]], x: f64) -> Option<f64> {
-    if branch.len() < 2 || x < branch[0][0] || x > branch[branch.len() - 1][0] {
-        return None;
-    }
-    let k = branch
-        .partition_point(|p| p[0] <= x)
-        .clamp(1, branch.len() - 1);
-    let (a, b) = (branch[k - 1], branch[k]);
-    let t = if b[0] > a[0] {
-        (x - a[0]) / (b[0] - a[0])
-    } else {
-        0.0
-    };
-    Some(a[1] + t * (b[1] - a[1]))
 }
 
 /// Everything needed to build the law of one fabric and adjust it.

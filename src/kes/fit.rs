@@ -5,9 +5,10 @@
 //! tension; elastic rigidity and friction threshold for shear and bending; a measured shear
 //! curve point by point — until the virtual experiment reproduces the targets.
 
-use super::calibrate::{self, interp, LawModel, TensileModel, Tests};
+use super::calibrate::{self, LawModel, TensileModel, Tests};
 use super::fabric::{FabricSpec, KesParam};
 use super::lab::{branches, measured_value, simulated_params};
+use super::parameters::interp;
 use super::rig::RigMesh;
 
 /// Fits the KES-parameter modes of `model` to the fabric's targets with the rigs on `mesh`.

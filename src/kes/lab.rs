@@ -5,9 +5,9 @@
 
 use std::path::{Path, PathBuf};
 
-use super::calibrate::{self, interp, LawModel, Measurements, ModeData, RigRun, Tests};
+use super::calibrate::{self, LawModel, Measurements, ModeData, RigRun, Tests};
 use super::fabric::{Curve, FabricSpec, KesParam};
-use super::parameters::{bending_parameters, shear_parameters, tensile_parameters};
+use super::parameters::{bending_parameters, interp, shear_parameters, tensile_parameters};
 use super::rig::{self, RigCurve, RigMesh};
 use super::units;
 use crate::cloth::{Direction, MaterialLaw};
