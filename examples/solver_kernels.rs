@@ -43,7 +43,7 @@ fn main() {
         let mut ls = LineSolver::new(&asm.a, n, n);
         let t = Instant::now();
         for _ in 0..reps {
-            ls.factor(&asm.a, &fixed);
+            ls.factor(&asm.a, &fixed, None);
         }
         println!(
             "factor {:.3} ms",
@@ -51,7 +51,7 @@ fn main() {
         );
         let t = Instant::now();
         for _ in 0..reps {
-            ls.sweep(&asm.a, LineDir::Warp, &x, &mut y, &fixed, [0, 1, 2], false);
+            ls.sweep(&asm.a, LineDir::Warp, &x, &mut y, &fixed, None, [0, 1, 2], false);
         }
         println!(
             "sweep warp {:.3} ms",
@@ -59,7 +59,7 @@ fn main() {
         );
         let t = Instant::now();
         for _ in 0..reps {
-            ls.sweep(&asm.a, LineDir::Weft, &x, &mut y, &fixed, [0, 1, 2], false);
+            ls.sweep(&asm.a, LineDir::Weft, &x, &mut y, &fixed, None, [0, 1, 2], false);
         }
         println!(
             "sweep weft {:.3} ms",

@@ -1,5 +1,6 @@
-//! The `emilion bench` benchmark: the peer hanging-cloth scene at several resolutions, one JSON
-//! line per case with the median time per substep over several runs after a warm-up.
+//! The `emilion bench` benchmark: the peer scenes (hanging cloth, drape on a sphere, hanging
+//! cloth with self-collision) at several resolutions, one JSON line per case with the median
+//! time per substep over several runs after a warm-up.
 
 use std::time::Instant;
 
@@ -43,16 +44,47 @@ pub struct BenchResult {
     pub levels: usize,
     /// Mean V-cycles per substep.
     pub vcycles: f64,
+    /// Mean collision detection + response time per substep (ms).
+    pub collision_ms: f64,
+    /// Collision time as a share of the substep time.
+    pub collision_share: f64,
+    /// Vertices inside bodies at the end.
+    pub penetrating: usize,
+    /// Intersecting cloth (edge, triangle) pairs at the end.
+    pub intersections: usize,
+    /// Smallest vertex–body distance over the run (m; null without bodies).
+    pub min_distance: Option<f64>,
 }
 
 /// Runs the hang scene at `n` × `n` for `frames` frames of 5 substeps, `runs` times after one
 /// warm-up run, and returns the median.
 pub fn bench_hang(n: usize, frames: u32, runs: usize) -> Result<BenchResult, ClothError> {
+    bench_scene("hang", n, frames, runs)
+}
+
+/// Runs scene `scene` ("hang", "drape" or "hang_self") at `n` × `n` for `frames` frames of 5
+/// substeps, `runs` times after one warm-up run, and returns the median run.
+pub fn bench_scene(
+    scene: &str,
+    n: usize,
+    frames: u32,
+    runs: usize,
+) -> Result<BenchResult, ClothError> {
     let substeps = 5;
     let runs = runs.max(1);
     let mut results = Vec::new();
+    let mut contact = Vec::new();
     for r in 0..=runs {
-        let mut sim = scenes::hang(n)?;
+        let mut sim = match scene {
+            "hang" => scenes::hang(n)?,
+            "drape" => scenes::drape(n)?,
+            "hang_self" => scenes::hang_self(n)?,
+            other => {
+                return Err(ClothError::Parameter(format!(
+                    "unknown bench scene `{other}` (hang, drape, hang_self)"
+                )))
+            }
+        };
         let steps = (frames * substeps) as u64;
         let t0 = Instant::now();
         sim.run_steps(steps, |_, _| Ok(()))?;
@@ -65,6 +97,16 @@ pub fn bench_hang(n: usize, frames: u32, runs: usize) -> Result<BenchResult, Clo
             let am = s.iter().map(|x| x.assemble_ms).sum::<f64>() / k;
             let sm = s.iter().map(|x| x.solve_ms).sum::<f64>() / k;
             let vc = sim.multigrid_timing().map_or(0.0, |t| t.2 as f64 / k);
+            let cm = s.iter().map(|x| x.collision_ms).sum::<f64>() / k;
+            let last = s.last().copied().unwrap_or_default();
+            let md = s.iter().map(|x| x.min_distance).fold(f64::INFINITY, f64::min);
+            contact.push((
+                ms,
+                cm,
+                last.penetrating,
+                last.intersections,
+                md.is_finite().then_some(md),
+            ));
             results.push((
                 ms,
                 iters,
@@ -82,11 +124,16 @@ pub fn bench_hang(n: usize, frames: u32, runs: usize) -> Result<BenchResult, Clo
     let mut sorted = results.clone();
     sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
     let med = sorted[sorted.len() / 2];
+    let c = contact
+        .iter()
+        .find(|c| c.0 == med.0)
+        .copied()
+        .unwrap_or((med.0, 0.0, 0, 0, None));
     runs_ms
         .iter_mut()
         .for_each(|x| *x = (*x * 1000.0).round() / 1000.0);
     Ok(BenchResult {
-        scene: "hang".into(),
+        scene: scene.into(),
         n,
         vertices: n * n,
         frames,
@@ -102,5 +149,10 @@ pub fn bench_hang(n: usize, frames: u32, runs: usize) -> Result<BenchResult, Clo
         threads: rayon::current_num_threads(),
         levels: med.8,
         vcycles: med.7,
+        collision_ms: c.1,
+        collision_share: c.1 / med.0,
+        penetrating: c.2,
+        intersections: c.3,
+        min_distance: c.4,
     })
 }

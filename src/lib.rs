@@ -9,7 +9,9 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod bench;
+pub mod body;
 pub mod cloth;
+pub mod contact;
 pub mod geometry;
 pub mod kes;
 pub mod render;

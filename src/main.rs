@@ -38,8 +38,11 @@ enum Command {
         /// Output folder.
         out_dir: PathBuf,
     },
-    /// Benchmarks the hanging-cloth scene; prints one JSON line per size.
+    /// Benchmarks the peer scenes; prints one JSON line per scene and size.
     Bench {
+        /// Scenes, comma-separated: hang, drape, hang_self.
+        #[arg(long, default_value = "hang")]
+        scenes: String,
         /// Particles per side, comma-separated.
         #[arg(long, default_value = "32,64,128,256")]
         sizes: String,
@@ -78,17 +81,20 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             }
         }
         Some(Command::Bench {
+            scenes,
             sizes,
             runs,
             frames,
         }) => {
-            for s in sizes.split(',') {
-                let n: usize = s
-                    .trim()
-                    .parse()
-                    .with_context(|| format!("bad size `{s}`"))?;
-                let r = emilion::bench::bench_hang(n, frames, runs)?;
-                println!("{}", serde_json::to_string(&r)?);
+            for scene in scenes.split(',') {
+                for s in sizes.split(',') {
+                    let n: usize = s
+                        .trim()
+                        .parse()
+                        .with_context(|| format!("bad size `{s}`"))?;
+                    let r = emilion::bench::bench_scene(scene.trim(), n, frames, runs)?;
+                    println!("{}", serde_json::to_string(&r)?);
+                }
             }
         }
         Some(cmd) => return scripting(cmd),

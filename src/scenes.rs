@@ -10,6 +10,8 @@ use crate::cloth::stats::write_csv;
 use crate::cloth::{
     ClothError, ClothModel, FabricParameters, Floor, Simulation, SimulationParameters,
 };
+use crate::contact::Body;
+use crate::geometry::Vec3;
 use crate::geometry::mesh::bounds;
 use crate::geometry::{write_glb, write_obj};
 use crate::render::{render_png, Camera, RenderMesh};
@@ -26,6 +28,33 @@ pub fn hang(n: usize) -> Result<Simulation, ClothError> {
     };
     let mut sim = Simulation::new(model, params)?;
     sim.pin(&[(n - 1) * n, n * n - 1])?;
+    Ok(sim)
+}
+
+/// The peer drape scene: the same 1 m × 1 m grid of `n` × `n` particles and fabric as
+/// [`hang`], flat at z = 0.45 m, centred above a static sphere of radius 0.3 m at the origin, no
+/// pins, collision distance 0.015 m, dt = 1/120 s (24 fps, 5 substeps).
+pub fn drape(n: usize) -> Result<Simulation, ClothError> {
+    let mut model = ClothModel::grid(1.0, 1.0, n, n, FabricParameters::default())?;
+    for p in &mut model.mesh.positions {
+        p.z = 0.45;
+    }
+    let params = SimulationParameters {
+        dt: 1.0 / 120.0,
+        ..Default::default()
+    };
+    let mut sim = Simulation::new(model, params)?;
+    sim.contact.settings.thickness = 0.015;
+    sim.contact.bodies.push(Body::sphere(Vec3::zeros(), 0.3)?);
+    Ok(sim)
+}
+
+/// The peer hang scene ([`hang`]) with self-collision on (self distance 0.005 m: the grid's
+/// diagonal half-spacing at n = 64 is 0.011 m, so Blender's 0.015 m would repel neighbours at rest).
+pub fn hang_self(n: usize) -> Result<Simulation, ClothError> {
+    let mut sim = hang(n)?;
+    sim.contact.settings.self_collision = true;
+    sim.contact.settings.self_thickness = 0.005;
     Ok(sim)
 }
 

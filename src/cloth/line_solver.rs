@@ -90,8 +90,9 @@ impl LineSolver {
         }
     }
 
-    /// Factorises the line systems of `a`; `fixed` particles get identity rows (no correction).
-    pub fn factor(&mut self, a: &Bcsr3, fixed: &[bool]) {
+    /// Factorises the line systems of `a` (plus the diagonal penalty blocks `pen`, if any);
+    /// `fixed` particles get identity rows (no correction).
+    pub fn factor(&mut self, a: &Bcsr3, fixed: &[bool], pen: Option<&[Sym3f]>) {
         let (nx, ny) = (self.nx, self.ny);
         for dir in [LineDir::Warp, LineDir::Weft] {
             let f = match dir {
@@ -143,7 +144,10 @@ impl LineSolver {
                         let mut d = if fixed[k] {
                             Mat3::identity()
                         } else {
-                            a.values32[a.diag[k]].to_mat3()
+                            match pen {
+                                Some(p) => a.values32[a.diag[k]].to_mat3() + p[k].to_mat3(),
+                                None => a.values32[a.diag[k]].to_mat3(),
+                            }
                         };
                         // eliminate column k − 2s, then column k − s
                         let l2 = if t >= 2 { a2 * g_2[q] } else { Mat3::zeros() };
@@ -187,9 +191,9 @@ impl LineSolver {
     }
 
     /// One block Gauss–Seidel sweep over all lines of `dir`: for each of three colours in
-    /// `order`, the residual `r − A e` of that colour's lines is solved exactly on each line
-    /// and added to `e`. Fixed particles keep a zero correction. `from_zero` says `e` is zero
-    /// on entry, which spares the first colour's matrix product.
+    /// `order`, the residual `r − (A + pen) e` of that colour's lines is solved exactly on each
+    /// line and added to `e`. Fixed particles keep a zero correction. `from_zero` says `e` is
+    /// zero on entry, which spares the first colour's matrix product.
     #[allow(clippy::too_many_arguments)]
     pub fn sweep(
         &mut self,
@@ -198,6 +202,7 @@ impl LineSolver {
         r: &[Vec3],
         e: &mut [Vec3],
         fixed: &[bool],
+        pen: Option<&[Sym3f]>,
         order: [usize; 3],
         from_zero: bool,
     ) {
@@ -230,7 +235,11 @@ impl LineSolver {
                                 if skip_product {
                                     r[k]
                                 } else {
-                                    r[k] - a.row_times32_ptr(k, ep.0)
+                                    let mut d = r[k] - a.row_times32_ptr(k, ep.0);
+                                    if let Some(p) = pen {
+                                        d -= p[k].mul(&*ep.at(k));
+                                    }
+                                    d
                                 }
                             };
                             // symmetric elimination: L(k, k−s) = U(k−s, k)ᵀ G(k−s); the

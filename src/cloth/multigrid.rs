@@ -6,7 +6,8 @@
 //! per step.
 
 use super::assembly::{Assembly, AssemblyInputs};
-use super::bcsr::Bcsr3;
+use super::bcsr::{Bcsr3, Sym3f};
+use super::constraints::{Filter, ParticleFilter};
 use super::line_solver::{LineDir, LineSolver};
 use super::model::ClothModel;
 use super::parallel::{for_each_mut, PAR_MIN};
@@ -118,6 +119,11 @@ struct Level {
     asm: Option<Assembly>,
     lines: LineSolver,
     fixed: Vec<bool>,
+    /// Constrained directions of each particle (contact normals; zero when free) and the
+    /// penalty blocks κ n nᵀ that stand for them in this level's operator.
+    pen_dir: Vec<Vec3>,
+    pen: Vec<Sym3f>,
+    penalized: bool,
     /// Transfer from the next coarser level to this one.
     to_fine: Option<Transfer>,
     /// Sampling of this level's state from the next finer level (coarse levels only).
@@ -157,6 +163,9 @@ impl Multigrid {
             asm: None,
             lines: LineSolver::new(a, nx, ny),
             fixed: vec![false; n],
+            pen_dir: vec![Vec3::zeros(); n],
+            pen: vec![Sym3f::default(); n],
+            penalized: false,
             to_fine: None,
             sample: Vec::new(),
             x: Vec::new(),
@@ -184,6 +193,9 @@ impl Multigrid {
                 asm: Some(asm),
                 lines,
                 fixed: vec![false; nc],
+                pen_dir: vec![Vec3::zeros(); nc],
+                pen: vec![Sym3f::default(); nc],
+                penalized: false,
                 to_fine: None,
                 sample: sampling((fx, fy), (cx, cy)),
                 x: vec![Vec3::zeros(); nc],
@@ -206,18 +218,38 @@ impl Multigrid {
     }
 
     /// Rebuilds every level's operator for the current step: coarse states sampled from the
-    /// fine one, coarse matrices assembled, fixed particles mapped, lines factorised.
+    /// fine one, coarse matrices assembled, fixed particles mapped, lines factorised. The
+    /// filter's fixed particles are fixed on every level; its velocity-constrained directions
+    /// (contacts) enter each level's operator as stiff penalty springs κ n nᵀ, so that the
+    /// V-cycle approximates the inverse of the constrained system rather than the free one.
     pub fn setup(
         &mut self,
         a: &Bcsr3,
         x: &[Vec3],
         v: &[Vec3],
-        fixed: &[bool],
+        filter: &Filter,
         inp: AssemblyInputs,
     ) {
         let t0 = std::time::Instant::now();
-        self.levels[0].fixed.copy_from_slice(fixed);
-        self.levels[0].lines.factor(a, fixed);
+        {
+            let l0 = &mut self.levels[0];
+            l0.penalized = false;
+            for (i, k) in filter.kind.iter().enumerate() {
+                l0.fixed[i] = matches!(k, ParticleFilter::Fixed { .. });
+                l0.pen_dir[i] = match k {
+                    ParticleFilter::Normal { normal, .. } => {
+                        l0.penalized = true;
+                        *normal
+                    }
+                    _ => Vec3::zeros(),
+                };
+            }
+            if l0.penalized {
+                fill_penalty(a, &l0.pen_dir, &mut l0.pen);
+            }
+            let pen = l0.penalized.then_some(&l0.pen[..]);
+            l0.lines.factor(a, &l0.fixed, pen);
+        }
         for l in 1..self.levels.len() {
             let (fine, coarse) = self.levels.split_at_mut(l);
             let f = &fine[l - 1];
@@ -229,10 +261,24 @@ impl Multigrid {
             for (i, s) in c.sample.iter().enumerate() {
                 c.fixed[i] = s.iter().any(|&(k, w)| w > 0.999_999 && f.fixed[k as usize]);
             }
+            c.penalized = f.penalized;
+            if f.penalized {
+                // a coarse particle keeps the constraint of the fine particle at its rest position
+                for (i, s) in c.sample.iter().enumerate() {
+                    c.pen_dir[i] = s
+                        .iter()
+                        .find(|&&(_, w)| w > 0.999_999)
+                        .map_or(Vec3::zeros(), |&(k, _)| f.pen_dir[k as usize]);
+                }
+            }
             let model = c.model.as_ref().expect("coarse model");
             let asm = c.asm.as_mut().expect("coarse assembly");
             asm.assemble(model, &c.x, &c.v, inp);
-            c.lines.factor(&asm.a, &c.fixed);
+            if c.penalized {
+                fill_penalty(&asm.a, &c.pen_dir, &mut c.pen);
+            }
+            let pen = c.penalized.then_some(&c.pen[..]);
+            c.lines.factor(&asm.a, &c.fixed, pen);
         }
         self.timing.0 += t0.elapsed().as_secs_f64();
     }
@@ -265,6 +311,7 @@ impl Multigrid {
                     &lv.r,
                     &mut lv.e,
                     &lv.fixed,
+                    lv.penalized.then_some(&lv.pen[..]),
                     FORWARD,
                     p == 0,
                 );
@@ -274,12 +321,20 @@ impl Multigrid {
                     &lv.r,
                     &mut lv.e,
                     &lv.fixed,
+                    lv.penalized.then_some(&lv.pen[..]),
                     FORWARD,
                     false,
                 );
             }
             if !last {
-                residual(a, &lv.r, &lv.e, &mut lv.d, &lv.fixed);
+                residual(
+                    a,
+                    &lv.r,
+                    &lv.e,
+                    &mut lv.d,
+                    &lv.fixed,
+                    lv.penalized.then_some(&lv.pen[..]),
+                );
             }
         }
         if !last {
@@ -312,6 +367,7 @@ impl Multigrid {
                 &lv.r,
                 &mut lv.e,
                 &lv.fixed,
+                lv.penalized.then_some(&lv.pen[..]),
                 BACKWARD,
                 false,
             );
@@ -321,6 +377,7 @@ impl Multigrid {
                 &lv.r,
                 &mut lv.e,
                 &lv.fixed,
+                lv.penalized.then_some(&lv.pen[..]),
                 BACKWARD,
                 false,
             );
@@ -331,17 +388,45 @@ impl Multigrid {
 const FORWARD: [usize; 3] = [0, 1, 2];
 const BACKWARD: [usize; 3] = [2, 1, 0];
 
-/// d = r − A e, zero at fixed particles.
-fn residual(a: &Bcsr3, r: &[Vec3], e: &[Vec3], d: &mut [Vec3], fixed: &[bool]) {
+/// d = r − (A + pen) e, zero at fixed particles.
+fn residual(
+    a: &Bcsr3,
+    r: &[Vec3],
+    e: &[Vec3],
+    d: &mut [Vec3],
+    fixed: &[bool],
+    pen: Option<&[Sym3f]>,
+) {
     let par = d.len() >= PAR_MIN;
     for_each_mut(d, par, |i, out| {
         *out = if fixed[i] {
             Vec3::zeros()
         } else {
             // SAFETY: `e` is a live slice of `a.rows()` vectors that nobody writes meanwhile.
-            r[i] - unsafe { a.row_times32_ptr(i, e.as_ptr()) }
+            let mut di = r[i] - unsafe { a.row_times32_ptr(i, e.as_ptr()) };
+            if let Some(p) = pen {
+                di -= p[i].mul(&e[i]);
+            }
+            di
         };
     });
+}
+
+/// Penalty stiffness of a constrained direction relative to the particle's own diagonal.
+const PENALTY: f64 = 1e3;
+
+/// Penalty blocks κ n nᵀ for the constrained directions `dirs` (zero vectors: none), κ a
+/// multiple of the largest entry of the particle's diagonal block of `a`.
+fn fill_penalty(a: &Bcsr3, dirs: &[Vec3], pen: &mut [Sym3f]) {
+    for (i, n) in dirs.iter().enumerate() {
+        pen[i] = if *n == Vec3::zeros() {
+            Sym3f::default()
+        } else {
+            let d = a.values32[a.diag[i]].to_mat3();
+            let kappa = PENALTY * d.diagonal().max();
+            Sym3f::from_upper(&(n * n.transpose() * kappa))
+        };
+    }
 }
 
 /// Width and height of a grid model from its rest coordinates.

@@ -14,6 +14,7 @@ use super::pcg::{PcgResult, PcgWorkspace, Preconditioner};
 use super::state::ClothState;
 use super::stats::StepStats;
 use super::ClothError;
+use crate::contact::Collisions;
 use crate::geometry::Vec3;
 
 /// Time integrator.
@@ -116,6 +117,8 @@ pub struct Simulation {
     pub attachments: Vec<Attachment>,
     /// Contact handlers consulted every step.
     pub hooks: Vec<Box<dyn ContactHook>>,
+    /// Collision bodies, self-collision and their settings.
+    pub contact: Collisions,
     /// Statistics of every step taken.
     pub stats: Vec<StepStats>,
     /// Steps whose CG solve did not reach the tolerance.
@@ -125,10 +128,11 @@ pub struct Simulation {
     dv: Vec<Vec3>,
     x_save: Vec<Vec3>,
     v_save: Vec<Vec3>,
+    impulse: Vec<Vec3>,
+    x_step: Vec<Vec3>,
     asm: Assembly,
     pcg: PcgWorkspace,
     mg: Option<Multigrid>,
-    fixed: Vec<bool>,
 }
 
 impl Simulation {
@@ -151,7 +155,12 @@ impl Simulation {
             asm.a.enable_mirror32();
             asm.jacobi = false;
         }
+        let mut contact = Collisions::default();
+        contact.set_cloth(&model.mesh.triangles, &model.mesh.positions);
         Ok(Simulation {
+            contact,
+            impulse: vec![Vec3::zeros(); n],
+            x_step: vec![Vec3::zeros(); n],
             state,
             params,
             attachments: Vec::new(),
@@ -166,7 +175,6 @@ impl Simulation {
             asm,
             pcg: PcgWorkspace::new(n),
             mg,
-            fixed: vec![false; n],
             model,
         })
     }
@@ -284,6 +292,15 @@ impl Simulation {
 
     fn build_filter(&mut self, t_end: f64, dt: f64) {
         self.filter.clear();
+        if self.contact.is_active() {
+            self.contact.begin_step(
+                &self.state.x,
+                &self.state.v,
+                t_end - dt,
+                dt,
+                &mut self.filter,
+            );
+        }
         for hook in &mut self.hooks {
             hook.constrain(
                 &self.state.x,
@@ -329,6 +346,7 @@ impl Simulation {
             self.state.v.copy_from_slice(&self.v_save);
             return Err(err);
         }
+        self.contact_stats(&mut st);
         st.step = self.state.step;
         st.time = self.state.time;
         st.step_ms = t_start.elapsed().as_secs_f64() * 1e3;
@@ -384,10 +402,7 @@ impl Simulation {
         }
         let mut precond = match self.mg.as_mut() {
             Some(mg) => {
-                for (f, k) in self.fixed.iter_mut().zip(&self.filter.kind) {
-                    *f = matches!(k, ParticleFilter::Fixed { .. });
-                }
-                mg.setup(&self.asm.a, &self.state.x, &self.state.v, &self.fixed, inp);
+                mg.setup(&self.asm.a, &self.state.x, &self.state.v, &self.filter, inp);
                 Preconditioner::Multigrid(mg)
             }
             None => Preconditioner::BlockJacobi(&self.asm.pinv),
@@ -422,11 +437,23 @@ impl Simulation {
             };
         }
         let t2 = Instant::now();
+        if self.contact.is_active() {
+            self.x_step.copy_from_slice(&self.state.x);
+            // constraint impulses: the residual A Δv − b lies in the constrained directions
+            for i in 0..self.particle_count() {
+                self.impulse[i] = match self.filter.kind[i] {
+                    ParticleFilter::Normal { .. } => {
+                        self.asm.a.row_times(i, &self.dv) - self.asm.b[i]
+                    }
+                    _ => Vec3::zeros(),
+                };
+            }
+        }
         for i in 0..self.particle_count() {
             self.state.v[i] += self.dv[i];
             self.state.x[i] += self.state.v[i] * h;
         }
-        self.finish_constraints();
+        self.finish_constraints(h);
         StepStats {
             kinetic,
             gravity,
@@ -441,8 +468,10 @@ impl Simulation {
         }
     }
 
-    /// Snaps fixed particles exactly onto their targets, then lets hooks correct positions.
-    fn finish_constraints(&mut self) {
+    /// Snaps fixed particles exactly onto their targets, lets hooks correct positions, then
+    /// runs the contact stage's response (friction, push-out, self-collision) on the step of
+    /// length `h` that started at `x_step`.
+    fn finish_constraints(&mut self, h: f64) {
         for i in 0..self.particle_count() {
             if let ParticleFilter::Fixed { target } = self.filter.kind[i] {
                 self.state.x[i] = target;
@@ -450,6 +479,32 @@ impl Simulation {
         }
         for hook in &mut self.hooks {
             hook.correct(&mut self.state.x, &mut self.state.v);
+        }
+        if self.contact.is_active() {
+            self.contact.end_step(
+                &self.x_step,
+                &mut self.state.x,
+                &mut self.state.v,
+                &self.impulse,
+                &self.model.mass,
+                &self.filter,
+                h,
+            );
+        }
+    }
+
+    /// Copies the contact stage's statistics of the last step into `st`.
+    fn contact_stats(&self, st: &mut StepStats) {
+        if self.contact.is_active() {
+            let c = &self.contact.stats;
+            st.collision_ms = c.collision_ms;
+            st.contacts = c.contacts;
+            st.self_contacts = c.self_contacts;
+            st.min_distance = c.min_distance;
+            st.penetrating = c.penetrating;
+            st.intersections = c.intersections;
+        } else {
+            st.min_distance = f64::INFINITY;
         }
     }
 
@@ -474,15 +529,20 @@ impl Simulation {
             if k == 0 {
                 elastic0 = e;
             }
+            if self.contact.is_active() {
+                self.x_step.copy_from_slice(&self.state.x);
+            }
             for i in 0..self.particle_count() {
                 let vn = self.state.v[i] + self.asm.b[i] * (h / self.model.mass[i]);
                 // constrained directions take the prescribed velocity
                 let z = self.filter.z(i, &self.state.x[i], &self.state.v[i], h);
-                self.state.v[i] = self.filter.apply(i, vn)
+                let v_new = self.filter.apply(i, vn)
                     + (self.state.v[i] + z - self.filter.apply(i, self.state.v[i] + z));
+                self.impulse[i] = (v_new - vn) * self.model.mass[i];
+                self.state.v[i] = v_new;
                 self.state.x[i] += self.state.v[i] * h;
             }
-            self.finish_constraints();
+            self.finish_constraints(h);
         }
         StepStats {
             kinetic,

@@ -34,9 +34,22 @@ pub struct StepStats {
     pub solve_ms: f64,
     /// Wall time of the whole step (ms).
     pub step_ms: f64,
+    /// Time in collision detection and response (ms).
+    pub collision_ms: f64,
+    /// Vertices constrained against bodies.
+    pub contacts: usize,
+    /// Cloth–cloth pairs in contact (closer than the self thickness) at the start of the step.
+    pub self_contacts: usize,
+    /// Smallest signed distance of a vertex to a body at the end of the step (m; infinite, and
+    /// written empty in CSV, without bodies near).
+    pub min_distance: f64,
+    /// Vertices inside a body at the end of the step.
+    pub penetrating: usize,
+    /// Intersecting (edge, triangle) pairs of the cloth at the end of the step.
+    pub intersections: usize,
 }
 
-const HEADER: &str = "step,time,kinetic,gravity,elastic,total,cg_iterations,residual,converged,assemble_ms,solve_ms,step_ms";
+const HEADER: &str = "step,time,kinetic,gravity,elastic,total,cg_iterations,residual,converged,assemble_ms,solve_ms,step_ms,collision_ms,contacts,self_contacts,min_distance,penetrating,intersections";
 
 fn write_atomic(path: &Path, body: &[u8]) -> Result<(), ClothError> {
     let err = |e: std::io::Error| ClothError::Output {
@@ -60,7 +73,7 @@ pub fn write_csv(path: &Path, stats: &[StepStats]) -> Result<(), ClothError> {
     s.push('\n');
     for r in stats {
         s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             r.step,
             r.time,
             r.kinetic,
@@ -72,7 +85,17 @@ pub fn write_csv(path: &Path, stats: &[StepStats]) -> Result<(), ClothError> {
             r.converged as u8,
             r.assemble_ms,
             r.solve_ms,
-            r.step_ms
+            r.step_ms,
+            r.collision_ms,
+            r.contacts,
+            r.self_contacts,
+            if r.min_distance.is_finite() {
+                r.min_distance.to_string()
+            } else {
+                String::new()
+            },
+            r.penetrating,
+            r.intersections
         ));
     }
     write_atomic(path, s.as_bytes())

@@ -1,0 +1,354 @@
+//! The contact stage of a simulation step. Before the implicit solve, every cloth vertex that
+//! will come within the thickness of a body during the step gets its normal velocity
+//! prescribed through Baraff–Witkin's filter (S = I − n nᵀ, z); after the solve the contact
+//! impulse read from the solve's residual drives Coulomb friction (static and kinetic), the
+//! vertices still inside the thickness are pushed out (Provot), cloth–cloth contact is resolved
+//! ([`SelfCollision`]), and the step's statistics are gathered.
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::body::{Body, FrictionCoefficients, Proximity};
+use super::self_collision::{SelfCollision, SelfCollisionReport};
+use super::ContactError;
+use crate::cloth::constraints::{Filter, ParticleFilter};
+use crate::geometry::Vec3;
+
+/// Contact settings of a cloth, SI units.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct ContactSettings {
+    /// Distance kept between the cloth and bodies (m).
+    pub thickness: f64,
+    /// The fabric's friction, combined with each body's (mean of the coefficients).
+    pub friction: FrictionCoefficients,
+    /// Whether the cloth collides with itself.
+    pub self_collision: bool,
+    /// Distance kept between two layers of cloth (m).
+    pub self_thickness: f64,
+    /// Kinetic friction coefficient of cloth on cloth.
+    pub self_friction: f64,
+    /// Largest speed (m/s) at which a vertex found inside the thickness is pushed out.
+    pub max_push_speed: f64,
+    /// Count intersecting (edge, triangle) pairs of the cloth after every step (statistics).
+    pub count_intersections: bool,
+}
+
+impl Default for ContactSettings {
+    fn default() -> Self {
+        ContactSettings {
+            thickness: 0.005,
+            friction: FrictionCoefficients::default(),
+            self_collision: false,
+            self_thickness: 0.004,
+            self_friction: 0.3,
+            max_push_speed: 1.0,
+            count_intersections: true,
+        }
+    }
+}
+
+impl ContactSettings {
+    /// Checks every value, naming the first bad one.
+    pub fn validate(&self) -> Result<(), ContactError> {
+        let bad = |name: &str, v: f64| {
+            ContactError::Parameter(format!("contact setting `{name}` is invalid: {v}"))
+        };
+        for (name, v) in [
+            ("thickness", self.thickness),
+            ("self_thickness", self.self_thickness),
+            ("max_push_speed", self.max_push_speed),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(bad(name, v));
+            }
+        }
+        if !(self.self_friction.is_finite() && self.self_friction >= 0.0) {
+            return Err(bad("self_friction", self.self_friction));
+        }
+        self.friction.validate("fabric friction")
+    }
+}
+
+/// Contact statistics of one step.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct ContactStats {
+    /// Vertices constrained against a body during the step.
+    pub contacts: usize,
+    /// Cloth–cloth pairs closer than the self thickness at the start of the step.
+    pub self_contacts: usize,
+    /// Continuous cloth–cloth hits resolved.
+    pub ccd_hits: usize,
+    /// Impact-zone rounds needed.
+    pub zone_rounds: usize,
+    /// Smallest signed distance of a cloth vertex to a body at the end of the step (m;
+    /// infinite without bodies near).
+    pub min_distance: f64,
+    /// Vertices inside a body at the end of the step.
+    pub penetrating: usize,
+    /// Intersecting (edge, triangle) pairs of the cloth at the end of the step (when counted).
+    pub intersections: usize,
+    /// Time in collision detection and response (ms).
+    pub collision_ms: f64,
+    /// Time spent counting intersections for these statistics (ms, not in `collision_ms`).
+    pub stats_ms: f64,
+}
+
+/// Per-vertex body contact of the current step.
+#[derive(Debug, Clone, Copy)]
+struct Slot {
+    body: u32,
+    normal: Vec3,
+    velocity: Vec3,
+}
+
+const NO_BODY: u32 = u32::MAX;
+
+/// Bodies, settings and workspaces of a cloth's contacts.
+#[derive(Debug, Clone, Default)]
+pub struct Collisions {
+    /// Collision bodies.
+    pub bodies: Vec<Body>,
+    /// Settings.
+    pub settings: ContactSettings,
+    /// Statistics of the last step.
+    pub stats: ContactStats,
+    slots: Vec<Slot>,
+    last_impulse: Vec<f64>,
+    self_collision: Option<SelfCollision>,
+    inv_mass: Vec<f64>,
+    ms: f64,
+}
+
+impl Collisions {
+    /// Whether anything collides (bodies, or self-collision on).
+    pub fn is_active(&self) -> bool {
+        !self.bodies.is_empty() || self.settings.self_collision
+    }
+
+    /// Prepares self-collision for a cloth with these triangles and rest positions.
+    pub fn set_cloth(&mut self, triangles: &[[usize; 3]], rest: &[Vec3]) {
+        self.self_collision = Some(SelfCollision::new(triangles, rest));
+    }
+
+    /// Before the solve of the step from `t` to `t + dt`: moves animated bodies to `t + dt` and
+    /// constrains the normal velocity of vertices that would end within the thickness.
+    pub fn begin_step(&mut self, x: &[Vec3], v: &[Vec3], t: f64, dt: f64, filter: &mut Filter) {
+        let t0 = Instant::now();
+        let n = x.len();
+        self.slots.clear();
+        self.slots.resize(
+            n,
+            Slot {
+                body: NO_BODY,
+                normal: Vec3::zeros(),
+                velocity: Vec3::zeros(),
+            },
+        );
+        self.last_impulse.resize(n, 0.0);
+        for b in &mut self.bodies {
+            b.advance_to(t + dt, dt);
+        }
+        self.stats = ContactStats {
+            min_distance: f64::INFINITY,
+            ..Default::default()
+        };
+        if self.bodies.is_empty() {
+            self.ms = t0.elapsed().as_secs_f64() * 1e3;
+            return;
+        }
+        let h = self.settings.thickness;
+        let bodies = &self.bodies;
+        let bounds: Vec<(Vec3, Vec3)> = bodies.iter().map(|b| b.bounds()).collect();
+        let last = &self.last_impulse;
+        let found: Vec<Option<(u32, Proximity)>> = (0..n)
+            .into_par_iter()
+            .with_min_len(256)
+            .map(|i| {
+                let reach = 1.5 * h + v[i].norm() * dt;
+                let mut best: Option<(u32, Proximity, f64)> = None;
+                for (k, b) in bodies.iter().enumerate() {
+                    let (lo, hi) = &bounds[k];
+                    if (0..3).any(|a| x[i][a] < lo[a] - reach || x[i][a] > hi[a] + reach) {
+                        continue;
+                    }
+                    if let Some(p) = b.proximity(&x[i], reach) {
+                        // predicted gap at the end of the step (the body is at its end pose)
+                        let gap = p.distance + v[i].dot(&p.normal) * dt;
+                        if best.as_ref().is_none_or(|bb| gap < bb.2) {
+                            best = Some((k as u32, p, gap));
+                        }
+                    }
+                }
+                let (k, p, gap) = best?;
+                // a contact that pulled last step lets go unless the vertex is inside
+                let pulling = last[i] < 0.0 && p.distance >= 0.9 * h;
+                (gap < 1.1 * h && !pulling).then_some((k, p))
+            })
+            .collect();
+        let max_push = self.settings.max_push_speed;
+        for (i, f) in found.into_iter().enumerate() {
+            let Some((k, p)) = f else {
+                self.last_impulse[i] = 0.0;
+                continue;
+            };
+            if matches!(filter.kind[i], ParticleFilter::Fixed { .. }) {
+                continue;
+            }
+            // end exactly at the thickness, never pushing out faster than max_push
+            let vn = ((h - p.distance) / dt).min(p.velocity.dot(&p.normal) + max_push);
+            filter.constrain_normal(i, p.normal, vn);
+            self.slots[i] = Slot {
+                body: k,
+                normal: p.normal,
+                velocity: p.velocity,
+            };
+            self.stats.contacts += 1;
+        }
+        self.ms = t0.elapsed().as_secs_f64() * 1e3;
+    }
+
+    /// After the solve: friction from the contact impulses `impulse` (momentum, from the
+    /// solve's residual), push-out of vertices inside the thickness, cloth–cloth response, and
+    /// statistics. `x_old` are the positions at the start of the step, `x`, `v` the solved end
+    /// state (corrected in place), `mass` the particle masses, `filter` the step's filter.
+    #[allow(clippy::too_many_arguments)]
+    pub fn end_step(
+        &mut self,
+        x_old: &[Vec3],
+        x: &mut [Vec3],
+        v: &mut [Vec3],
+        impulse: &[Vec3],
+        mass: &[f64],
+        filter: &Filter,
+        dt: f64,
+    ) {
+        let t0 = Instant::now();
+        let n = x.len();
+        let h = self.settings.thickness;
+        // friction at body contacts
+        for i in 0..n {
+            let s = self.slots[i];
+            if s.body == NO_BODY || !matches!(filter.kind[i], ParticleFilter::Normal { .. }) {
+                continue;
+            }
+            let jn = s.normal.dot(&impulse[i]);
+            self.last_impulse[i] = jn;
+            if jn <= 0.0 {
+                continue;
+            }
+            let mu = self.settings.friction.combine(&self.bodies[s.body as usize].friction);
+            let rel = v[i] - s.velocity;
+            let vn = s.normal * s.normal.dot(&rel);
+            let vt = rel - vn;
+            let speed = vt.norm();
+            let dv = jn / mass[i];
+            let vt_new = if speed <= mu.static_ * dv {
+                Vec3::zeros()
+            } else {
+                vt * (1.0 - mu.kinetic * dv / speed).max(0.0)
+            };
+            v[i] = s.velocity + vn + vt_new;
+            x[i] = x_old[i] + v[i] * dt;
+        }
+        // push-out (Provot) and body statistics
+        if !self.bodies.is_empty() {
+            self.push_out(x, v, filter, h);
+        }
+        // cloth–cloth
+        if self.settings.self_collision {
+            if let Some(sc) = self.self_collision.as_mut() {
+                self.inv_mass.clear();
+                self.inv_mass.extend((0..n).map(|i| match filter.kind[i] {
+                    ParticleFilter::Fixed { .. } => 0.0,
+                    _ => 1.0 / mass[i],
+                }));
+                let rep: SelfCollisionReport = sc.respond(
+                    x_old,
+                    x,
+                    v,
+                    &self.inv_mass,
+                    dt,
+                    self.settings.self_thickness,
+                    self.settings.self_friction,
+                );
+                self.stats.self_contacts = rep.proximities;
+                self.stats.ccd_hits = rep.ccd_hits;
+                self.stats.zone_rounds = rep.zone_rounds;
+            }
+        }
+        self.stats.collision_ms = self.ms + t0.elapsed().as_secs_f64() * 1e3;
+        let t1 = Instant::now();
+        if !self.bodies.is_empty() {
+            self.body_statistics(x);
+        }
+        if self.settings.count_intersections {
+            if let Some(sc) = self.self_collision.as_mut() {
+                self.stats.intersections = sc.count_intersections(x);
+            }
+        }
+        self.stats.stats_ms = t1.elapsed().as_secs_f64() * 1e3;
+    }
+
+    /// Moves vertices closer than half the thickness to a body back out to half the thickness
+    /// and removes their approaching normal velocity.
+    fn push_out(&self, x: &mut [Vec3], v: &mut [Vec3], filter: &Filter, h: f64) {
+        let bodies = &self.bodies;
+        let target = 0.5 * h;
+        x.par_iter_mut()
+            .zip(v.par_iter_mut())
+            .enumerate()
+            .with_min_len(256)
+            .for_each(|(i, (xi, vi))| {
+                if matches!(filter.kind[i], ParticleFilter::Fixed { .. }) {
+                    return;
+                }
+                for b in bodies {
+                    let (lo, hi) = b.bounds();
+                    if (0..3).any(|a| xi[a] < lo[a] - h || xi[a] > hi[a] + h) {
+                        continue;
+                    }
+                    let inside_box = (0..3).all(|a| xi[a] >= lo[a] && xi[a] <= hi[a]);
+                    let reach = if inside_box { f64::INFINITY } else { h };
+                    if let Some(p) = b.proximity(xi, reach) {
+                        if p.distance < target {
+                            *xi += p.normal * (target - p.distance);
+                            let rel = (*vi - p.velocity).dot(&p.normal);
+                            if rel < 0.0 {
+                                *vi -= p.normal * rel;
+                            }
+                        }
+                    }
+                }
+            });
+    }
+
+    fn body_statistics(&mut self, x: &[Vec3]) {
+        let bodies = &self.bodies;
+        let h = self.settings.thickness;
+        let (min, inside) = x
+            .par_iter()
+            .with_min_len(256)
+            .map(|xi| {
+                let mut m = f64::INFINITY;
+                for b in bodies {
+                    let (lo, hi) = b.bounds();
+                    if (0..3).any(|a| xi[a] < lo[a] - 4.0 * h || xi[a] > hi[a] + 4.0 * h) {
+                        continue;
+                    }
+                    if let Some(p) = b.proximity(xi, f64::INFINITY) {
+                        m = m.min(p.distance);
+                    }
+                }
+                (m, usize::from(m < 0.0))
+            })
+            .reduce(
+                || (f64::INFINITY, 0),
+                |a, b| (a.0.min(b.0), a.1 + b.1),
+            );
+        self.stats.min_distance = min;
+        self.stats.penetrating = inside;
+    }
+}

@@ -1,0 +1,20 @@
+//! Contact: collision bodies (sphere, box, plane, static or animated triangle meshes with
+//! parry's BVH), the per-step contact stage of a simulation (Baraff–Witkin velocity
+//! constraints, Coulomb friction from the solve's contact impulses, Provot push-out), cloth
+//! self-collision (repulsion, continuous detection, impact zones) over a spatial hash, and the
+//! exact geometric primitives they rest on.
+
+pub mod body;
+pub mod ccd;
+pub mod collisions;
+pub mod error;
+pub mod mesh_body;
+pub mod primitives;
+pub mod self_collision;
+pub mod spatial_hash;
+
+pub use body::{Body, FrictionCoefficients, Proximity, Shape};
+pub use collisions::{Collisions, ContactSettings, ContactStats};
+pub use error::ContactError;
+pub use mesh_body::{BodyAnimation, MeshBody};
+pub use self_collision::{SelfCollision, SelfCollisionReport};

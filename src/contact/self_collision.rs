@@ -1,0 +1,570 @@
+//! Cloth–cloth collisions (Bridson, Fedkiw & Anderson 2002, after Provot 1997), applied to the
+//! step's displacements `d = x1 − x0` from a state `x0` free of intersections:
+//! 1. **repulsion**: vertex–triangle and edge–edge pairs closer than the thickness at the start
+//!    and approaching lose their approach (inelastic impulse, a small push apart, Coulomb friction);
+//! 2. **continuous detection**: the cubic coplanarity test on every candidate pair's linear
+//!    motion; each hit gets an impulse leaving the pair a quarter thickness apart; repeated;
+//! 3. **impact zones**: if hits remain, the vertices of colliding pairs are merged into zones
+//!    moved rigidly (momentum and angular momentum kept), which cannot tangle themselves;
+//!    zones grow until nothing crosses; as a last resort the remaining vertices stop.
+//!
+//! Velocities change by the displacement corrections over dt. Candidate pairs come from a
+//! spatial hash of swept boxes (see [`SpatialHash`]); pairs sharing a vertex are skipped.
+
+use nalgebra::Rotation3;
+use rayon::prelude::*;
+
+use super::ccd::{edge_edge_ccd, vertex_face_ccd, CcdHit};
+use super::primitives::{closest_point_triangle, closest_points_segments, segment_triangle_intersect};
+use super::spatial_hash::{Aabb, SpatialHash};
+use crate::geometry::{Mat3, Vec3};
+
+/// Repeated continuous-detection passes before impact zones take over.
+const CCD_PASSES: usize = 6;
+/// Impact-zone rounds before the last-resort stop.
+const ZONE_ROUNDS: usize = 24;
+/// Pairs are left this fraction of the thickness apart after a continuous hit.
+const SEPARATION: f64 = 0.25;
+/// Fraction of the overlap recovered per step by the repulsion push.
+const PUSH: f64 = 0.2;
+
+/// What one call of [`SelfCollision::respond`] did.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SelfCollisionReport {
+    /// Pairs closer than the thickness at the start of the step.
+    pub proximities: usize,
+    /// Continuous-detection hits over all passes.
+    pub ccd_hits: usize,
+    /// Continuous-detection passes run.
+    pub passes: usize,
+    /// Impact-zone rounds run.
+    pub zone_rounds: usize,
+    /// Vertices stopped by the last resort.
+    pub stopped: usize,
+}
+
+/// Self-collision topology and workspaces of one cloth.
+#[derive(Debug, Clone)]
+pub struct SelfCollision {
+    triangles: Vec<[u32; 3]>,
+    edges: Vec<[u32; 2]>,
+    cell: f64,
+    tri_boxes: Vec<Aabb>,
+    edge_boxes: Vec<Aabb>,
+    tri_hash: SpatialHash,
+    edge_hash: SpatialHash,
+    vf: Vec<(u32, u32)>,
+    ee: Vec<(u32, u32)>,
+    d: Vec<Vec3>,
+    d_in: Vec<Vec3>,
+    d_bp: Vec<Vec3>,
+    parent: Vec<u32>,
+}
+
+impl SelfCollision {
+    /// Self-collision for the triangles of a cloth whose rest positions are `rest` (the grid's
+    /// cell size follows the mean edge length).
+    pub fn new(triangles: &[[usize; 3]], rest: &[Vec3]) -> SelfCollision {
+        let mut edges: Vec<[u32; 2]> = triangles
+            .iter()
+            .flat_map(|t| {
+                (0..3).map(move |k| {
+                    let (a, b) = (t[k] as u32, t[(k + 1) % 3] as u32);
+                    [a.min(b), a.max(b)]
+                })
+            })
+            .collect();
+        edges.sort_unstable();
+        edges.dedup();
+        let mean = edges
+            .iter()
+            .map(|e| (rest[e[0] as usize] - rest[e[1] as usize]).norm())
+            .sum::<f64>()
+            / edges.len().max(1) as f64;
+        SelfCollision {
+            triangles: triangles.iter().map(|t| t.map(|i| i as u32)).collect(),
+            edges,
+            cell: (2.0 * mean).max(1e-4),
+            tri_boxes: Vec::new(),
+            edge_boxes: Vec::new(),
+            tri_hash: SpatialHash::default(),
+            edge_hash: SpatialHash::default(),
+            vf: Vec::new(),
+            ee: Vec::new(),
+            d: Vec::new(),
+            d_in: Vec::new(),
+            d_bp: Vec::new(),
+            parent: Vec::new(),
+        }
+    }
+
+    /// Unique undirected edges of the cloth.
+    pub fn edges(&self) -> &[[u32; 2]] {
+        &self.edges
+    }
+
+    /// Candidate pairs whose boxes, swept from `x0` to `x0 + d`, come closer than `pad`.
+    fn broad_phase(&mut self, x0: &[Vec3], pad: f64) {
+        self.d_bp.clear();
+        self.d_bp.extend_from_slice(&self.d);
+        let d = &self.d;
+        let swept = |ids: &[u32], pad: f64| {
+            let mut b = Aabb::empty();
+            for &i in ids {
+                let i = i as usize;
+                b.grow(&x0[i]);
+                b.grow(&(x0[i] + d[i]));
+            }
+            b.inflated(pad)
+        };
+        self.tri_boxes.clear();
+        self.tri_boxes.extend(self.triangles.iter().map(|t| swept(t, pad)));
+        self.edge_boxes.clear();
+        self.edge_boxes.extend(self.edges.iter().map(|e| swept(e, 0.5 * pad)));
+        self.tri_hash.build(&self.tri_boxes, self.cell);
+        self.edge_hash.build(&self.edge_boxes, self.cell);
+        let (tris, edges) = (&self.triangles, &self.edges);
+        let (tri_hash, edge_hash, edge_boxes) = (&self.tri_hash, &self.edge_hash, &self.edge_boxes);
+        let n = x0.len();
+        let chunk = 512;
+        let vf: Vec<Vec<(u32, u32)>> = (0..n.div_ceil(chunk))
+            .into_par_iter()
+            .map(|c| {
+                let (mut out, mut buf) = (Vec::new(), Vec::new());
+                for i in c * chunk..((c + 1) * chunk).min(n) {
+                    let mut b = Aabb::empty();
+                    b.grow(&x0[i]);
+                    b.grow(&(x0[i] + d[i]));
+                    tri_hash.query(&b, &mut buf);
+                    let iu = i as u32;
+                    out.extend(buf.iter().filter(|&&t| !tris[t as usize].contains(&iu)).map(|&t| (iu, t)));
+                }
+                out
+            })
+            .collect();
+        let ne = edges.len();
+        let ee: Vec<Vec<(u32, u32)>> = (0..ne.div_ceil(chunk))
+            .into_par_iter()
+            .map(|c| {
+                let (mut out, mut buf) = (Vec::new(), Vec::new());
+                for e in c * chunk..((c + 1) * chunk).min(ne) {
+                    edge_hash.query(&edge_boxes[e], &mut buf);
+                    let [a, b] = edges[e];
+                    out.extend(
+                        buf.iter()
+                            .filter(|&&f| {
+                                let [p, q] = edges[f as usize];
+                                f as usize > e && p != a && p != b && q != a && q != b
+                            })
+                            .map(|&f| (e as u32, f)),
+                    );
+                }
+                out
+            })
+            .collect();
+        self.vf.clear();
+        self.vf.extend(vf.into_iter().flatten());
+        self.ee.clear();
+        self.ee.extend(ee.into_iter().flatten());
+    }
+
+    /// The four vertices of candidate `k` (vertex–face pairs first, then edge–edge).
+    #[inline]
+    fn pair_vertices(&self, k: usize) -> [usize; 4] {
+        if k < self.vf.len() {
+            let (i, t) = self.vf[k];
+            let t = self.triangles[t as usize];
+            [i as usize, t[0] as usize, t[1] as usize, t[2] as usize]
+        } else {
+            let (e, f) = self.ee[k - self.vf.len()];
+            let (e, f) = (self.edges[e as usize], self.edges[f as usize]);
+            [e[0] as usize, e[1] as usize, f[0] as usize, f[1] as usize]
+        }
+    }
+
+    /// Moves the displacements of `vs` so that their weighted relative displacement along `n`
+    /// is at least `target`; returns the correction applied (≥ 0), 0 if none was needed.
+    fn push_apart(
+        d: &mut [Vec3],
+        inv_mass: &[f64],
+        vs: &[usize; 4],
+        w: &[f64; 4],
+        n: &Vec3,
+        target: f64,
+    ) -> f64 {
+        let u: f64 = (0..4).map(|k| w[k] * d[vs[k]].dot(n)).sum();
+        if u >= target {
+            return 0.0;
+        }
+        let den: f64 = (0..4).map(|k| w[k] * w[k] * inv_mass[vs[k]]).sum();
+        if den <= 0.0 {
+            return 0.0;
+        }
+        let lambda = (target - u) / den;
+        for k in 0..4 {
+            d[vs[k]] += n * (w[k] * inv_mass[vs[k]] * lambda);
+        }
+        target - u
+    }
+
+    /// Resolves cloth–cloth contact on the step from `x0` (intersection-free) to `x1`: `x1`
+    /// and `v` are corrected in place. `inv_mass` is 0 for vertices whose motion is prescribed.
+    #[allow(clippy::too_many_arguments)]
+    pub fn respond(
+        &mut self,
+        x0: &[Vec3],
+        x1: &mut [Vec3],
+        v: &mut [Vec3],
+        inv_mass: &[f64],
+        dt: f64,
+        thickness: f64,
+        friction: f64,
+    ) -> SelfCollisionReport {
+        let n = x0.len();
+        let mut rep = SelfCollisionReport::default();
+        self.d.clear();
+        self.d.extend((0..n).map(|i| x1[i] - x0[i]));
+        self.d_in.clear();
+        self.d_in.extend_from_slice(&self.d);
+
+        // candidates stay valid while no displacement changes by more than `margin`
+        let margin = thickness;
+        let pad = thickness + margin;
+        // 1. repulsion of close, approaching pairs
+        let debug = std::env::var_os("EMILION_DEBUG_SELF").is_some();
+        let tdbg = std::time::Instant::now();
+        self.broad_phase(x0, pad);
+        let pairs = self.vf.len() + self.ee.len();
+        for k in 0..pairs {
+            let vs = self.pair_vertices(k);
+            if separated(x0, &vs, k < self.vf.len(), thickness) {
+                continue;
+            }
+            let Some((dist, w, nrm)) = self.proximity(k, x0, &vs) else {
+                continue;
+            };
+            if dist >= thickness {
+                continue;
+            }
+            rep.proximities += 1;
+            let target = PUSH * (thickness - dist);
+            let dn = Self::push_apart(&mut self.d, inv_mass, &vs, &w, &nrm, target);
+            if dn > 0.0 && friction > 0.0 {
+                // Coulomb: the relative tangential displacement shrinks by μ times the normal change
+                let rel: Vec3 = (0..4).map(|k| self.d[vs[k]] * w[k]).sum();
+                let tang = rel - nrm * nrm.dot(&rel);
+                let len = tang.norm();
+                if len > 1e-15 {
+                    let t = tang / len;
+                    let goal = (len - friction * dn).max(0.0);
+                    let u = len;
+                    let den: f64 = (0..4).map(|k| w[k] * w[k] * inv_mass[vs[k]]).sum();
+                    if den > 0.0 {
+                        let lambda = (goal - u) / den;
+                        for k in 0..4 {
+                            self.d[vs[k]] += t * (w[k] * inv_mass[vs[k]] * lambda);
+                        }
+                    }
+                }
+            }
+        }
+
+        if debug {
+            eprintln!(
+                "self: {} vf, {} ee candidates, broad+proximity {:.2} ms",
+                self.vf.len(),
+                self.ee.len(),
+                tdbg.elapsed().as_secs_f64() * 1e3
+            );
+        }
+        let tdbg = std::time::Instant::now();
+        // 2. continuous detection passes
+        let mut hits = Vec::new();
+        let mut resolved = false;
+        for pass in 0..CCD_PASSES {
+            rep.passes = pass + 1;
+            if pass > 0 && self.stale(margin) {
+                self.broad_phase(x0, pad);
+            }
+            self.find_hits(x0, thickness, &mut hits);
+            if hits.is_empty() {
+                resolved = true;
+                break;
+            }
+            rep.ccd_hits += hits.len();
+            for (k, hit) in &hits {
+                let vs = self.pair_vertices(*k);
+                let s0: f64 = (0..4).map(|m| hit.weights[m] * x0[vs[m]].dot(&hit.normal)).sum();
+                let target = SEPARATION * thickness - s0;
+                Self::push_apart(&mut self.d, inv_mass, &vs, &hit.weights, &hit.normal, target);
+            }
+        }
+
+        if debug {
+            eprintln!(
+                "self: ccd {} passes {:.2} ms",
+                rep.passes,
+                tdbg.elapsed().as_secs_f64() * 1e3
+            );
+        }
+        // 3. impact zones
+        if !resolved {
+            self.parent.clear();
+            self.parent.extend(0..n as u32);
+            for round in 0..ZONE_ROUNDS {
+                rep.zone_rounds = round + 1;
+                if self.stale(margin) {
+                    self.broad_phase(x0, pad);
+                }
+                self.find_hits(x0, thickness, &mut hits);
+                if hits.is_empty() {
+                    resolved = true;
+                    break;
+                }
+                for (k, _) in &hits {
+                    let vs = self.pair_vertices(*k);
+                    for m in 1..4 {
+                        union(&mut self.parent, vs[0], vs[m]);
+                    }
+                }
+                self.rigidify_zones(x0, inv_mass);
+            }
+            if !resolved {
+                // last resort: everything in a zone stays where it was
+                for (_, i) in self.zone_members() {
+                    self.d[i as usize] = Vec3::zeros();
+                    rep.stopped += 1;
+                }
+                self.broad_phase(x0, pad);
+                self.find_hits(x0, thickness, &mut hits);
+                if !hits.is_empty() {
+                    rep.stopped = n;
+                    self.d.fill(Vec3::zeros());
+                }
+            }
+        }
+
+        for i in 0..n {
+            let change = self.d[i] - self.d_in[i];
+            if change != Vec3::zeros() {
+                x1[i] = x0[i] + self.d[i];
+                v[i] += change / dt;
+            }
+        }
+        rep
+    }
+
+    /// Whether some displacement moved more than `margin` since the candidates were found.
+    fn stale(&self, margin: f64) -> bool {
+        let m2 = margin * margin;
+        self.d
+            .iter()
+            .zip(&self.d_bp)
+            .any(|(a, b)| (a - b).norm_squared() > m2)
+    }
+
+    /// Distance, Bridson weights and unit normal (pointing toward the first primitive) of
+    /// candidate `k` at positions `x`.
+    fn proximity(&self, k: usize, x: &[Vec3], vs: &[usize; 4]) -> Option<(f64, [f64; 4], Vec3)> {
+        let p = vs.map(|i| x[i]);
+        let (gap, w) = if k < self.vf.len() {
+            let (q, b) = closest_point_triangle(p[0], p[1], p[2], p[3]);
+            (p[0] - q, [1.0, -b[0], -b[1], -b[2]])
+        } else {
+            let (s, t, a, b) = closest_points_segments(p[0], p[1], p[2], p[3]);
+            (a - b, [1.0 - s, s, -(1.0 - t), -t])
+        };
+        let dist = gap.norm();
+        let nrm = if dist > 1e-12 {
+            gap / dist
+        } else if k < self.vf.len() {
+            let nt = (p[2] - p[1]).cross(&(p[3] - p[1]));
+            nt.try_normalize(1e-300)?
+        } else {
+            let ne = (p[1] - p[0]).cross(&(p[3] - p[2]));
+            ne.try_normalize(1e-300)?
+        };
+        Some((dist, w, nrm))
+    }
+
+    /// Continuous hits of all candidates on the motion `x0 → x0 + d`, in candidate order.
+    fn find_hits(&self, x0: &[Vec3], thickness: f64, hits: &mut Vec<(usize, CcdHit)>) {
+        let d = &self.d;
+        let nvf = self.vf.len();
+        let total = nvf + self.ee.len();
+        let chunk = 1024;
+        let found: Vec<Vec<(usize, CcdHit)>> = (0..total.div_ceil(chunk))
+            .into_par_iter()
+            .map(|c| {
+                let mut out = Vec::new();
+                for k in c * chunk..((c + 1) * chunk).min(total) {
+                    let vs = self.pair_vertices(k);
+                    let xs = vs.map(|i| x0[i]);
+                    let ds = vs.map(|i| d[i]);
+                    let hit = if k < nvf {
+                        vertex_face_ccd(xs, ds, thickness * 0.1)
+                    } else {
+                        edge_edge_ccd(xs, ds, thickness * 0.1)
+                    };
+                    if let Some(h) = hit {
+                        out.push((k, h));
+                    }
+                }
+                out
+            })
+            .collect();
+        hits.clear();
+        hits.extend(found.into_iter().flatten());
+    }
+
+    /// (root, vertex) for every vertex of an impact zone (a union–find class of more than one
+    /// vertex), sorted.
+    fn zone_members(&mut self) -> Vec<(u32, u32)> {
+        let n = self.parent.len();
+        let roots: Vec<u32> = (0..n).map(|i| find(&mut self.parent, i)).collect();
+        let mut size = vec![0u32; n];
+        for r in &roots {
+            size[*r as usize] += 1;
+        }
+        let mut m: Vec<(u32, u32)> = (0..n)
+            .filter(|&i| size[roots[i] as usize] > 1)
+            .map(|i| (roots[i], i as u32))
+            .collect();
+        m.sort_unstable();
+        m
+    }
+
+    /// Replaces the displacements of every impact zone by the zone's rigid motion with the
+    /// same momentum and angular momentum.
+    fn rigidify_zones(&mut self, x0: &[Vec3], inv_mass: &[f64]) {
+        let members = self.zone_members();
+        let mut start = 0;
+        while start < members.len() {
+            let root = members[start].0;
+            let mut end = start;
+            while end < members.len() && members[end].0 == root {
+                end += 1;
+            }
+            let zone: Vec<usize> = members[start..end].iter().map(|m| m.1 as usize).collect();
+            self.rigid_motion(&zone, x0, inv_mass);
+            start = end;
+        }
+    }
+
+    fn rigid_motion(&mut self, zone: &[usize], x0: &[Vec3], inv_mass: &[f64]) {
+        let pinned: Vec<usize> = zone.iter().copied().filter(|&i| inv_mass[i] == 0.0).collect();
+        if !pinned.is_empty() {
+            // a zone holding prescribed vertices follows their mean displacement
+            let mean = pinned.iter().map(|&i| self.d[i]).sum::<Vec3>() / pinned.len() as f64;
+            for &i in zone {
+                if inv_mass[i] != 0.0 {
+                    self.d[i] = mean;
+                }
+            }
+            return;
+        }
+        let mass = |i: usize| 1.0 / inv_mass[i];
+        let m: f64 = zone.iter().map(|&i| mass(i)).sum();
+        let c = zone.iter().map(|&i| x0[i] * mass(i)).sum::<Vec3>() / m;
+        let dc = zone.iter().map(|&i| self.d[i] * mass(i)).sum::<Vec3>() / m;
+        let mut l = Vec3::zeros();
+        let mut inertia = Mat3::zeros();
+        for &i in zone {
+            let r = x0[i] - c;
+            l += (r.cross(&(self.d[i] - dc))) * mass(i);
+            inertia += (Mat3::identity() * r.norm_squared() - r * r.transpose()) * mass(i);
+        }
+        let omega = inertia
+            .try_inverse()
+            .map_or(Vec3::zeros(), |inv| inv * l);
+        let rot = Rotation3::new(omega);
+        for &i in zone {
+            let r = x0[i] - c;
+            self.d[i] = dc + rot * r - r;
+        }
+    }
+
+    /// Number of (edge, triangle) pairs of the cloth at `x` that intersect, pairs sharing a
+    /// vertex excluded (fast floating-point test).
+    pub fn count_intersections(&mut self, x: &[Vec3]) -> usize {
+        let tight = |ids: &[u32]| {
+            let mut b = Aabb::empty();
+            for &i in ids {
+                b.grow(&x[i as usize]);
+            }
+            b
+        };
+        self.tri_boxes.clear();
+        self.tri_boxes.extend(self.triangles.iter().map(|t| tight(t)));
+        self.tri_hash.build(&self.tri_boxes, self.cell);
+        let (tris, edges, hash) = (&self.triangles, &self.edges, &self.tri_hash);
+        let ne = edges.len();
+        let chunk = 1024;
+        (0..ne.div_ceil(chunk))
+            .into_par_iter()
+            .map(|c| {
+                let mut buf = Vec::new();
+                let mut count = 0;
+                for e in c * chunk..((c + 1) * chunk).min(ne) {
+                    let [a, b] = edges[e];
+                    hash.query(&tight(&[a, b]), &mut buf);
+                    for &t in &buf {
+                        let t = tris[t as usize];
+                        if t.contains(&a) || t.contains(&b) {
+                            continue;
+                        }
+                        let p = t.map(|i| x[i as usize]);
+                        if segment_triangle_intersect(x[a as usize], x[b as usize], p[0], p[1], p[2]) {
+                            count += 1;
+                        }
+                    }
+                }
+                count
+            })
+            .sum()
+    }
+}
+
+/// Whether the two primitives of a candidate (vertex and triangle, or two edges) at `x` have
+/// bounding boxes more than `gap` apart along some axis (then they are not in proximity).
+#[inline]
+fn separated(x: &[Vec3], vs: &[usize; 4], vertex_face: bool, gap: f64) -> bool {
+    let split = if vertex_face { 1 } else { 2 };
+    (0..3).any(|a| {
+        let (mut lo0, mut hi0, mut lo1, mut hi1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+        for (m, &i) in vs.iter().enumerate() {
+            let c = x[i][a];
+            if m < split {
+                lo0 = lo0.min(c);
+                hi0 = hi0.max(c);
+            } else {
+                lo1 = lo1.min(c);
+                hi1 = hi1.max(c);
+            }
+        }
+        lo0 > hi1 + gap || lo1 > hi0 + gap
+    })
+}
+
+fn find(parent: &mut [u32], i: usize) -> u32 {
+    let mut r = i as u32;
+    while parent[r as usize] != r {
+        r = parent[r as usize];
+    }
+    let mut k = i as u32;
+    while parent[k as usize] != r {
+        let next = parent[k as usize];
+        parent[k as usize] = r;
+        k = next;
+    }
+    r
+}
+
+fn union(parent: &mut [u32], a: usize, b: usize) {
+    let (ra, rb) = (find(parent, a), find(parent, b));
+    if ra != rb {
+        // the smaller index is the root: deterministic
+        let (lo, hi) = (ra.min(rb), ra.max(rb));
+        parent[hi as usize] = lo;
+    }
+}
