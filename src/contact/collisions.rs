@@ -10,7 +10,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::body::{Body, FrictionCoefficients, Proximity};
+use super::body::{Body, FrictionCoefficients, Proximity, Shape};
 use super::self_collision::{SelfCollision, SelfCollisionReport};
 use super::ContactError;
 use crate::cloth::constraints::{Filter, ParticleFilter};
@@ -96,6 +96,20 @@ pub struct ContactStats {
     pub stats_ms: f64,
 }
 
+/// A cloth particle held at a fixed distance along the normal of a mesh body's vertex, so that
+/// it follows the (animated) body: a waistband on a character.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyPin {
+    /// The body (a mesh).
+    pub body: usize,
+    /// The cloth particle.
+    pub particle: usize,
+    /// The body vertex it follows.
+    pub vertex: usize,
+    /// Distance along the vertex normal (m).
+    pub offset: f64,
+}
+
 /// Per-vertex body contact of the current step.
 #[derive(Debug, Clone, Copy)]
 struct Slot {
@@ -115,6 +129,8 @@ pub struct Collisions {
     pub settings: ContactSettings,
     /// Statistics of the last step.
     pub stats: ContactStats,
+    /// Particles that follow mesh bodies.
+    pub pins: Vec<BodyPin>,
     slots: Vec<Slot>,
     last_impulse: Vec<f64>,
     self_collision: Option<SelfCollision>,
@@ -131,6 +147,52 @@ impl Collisions {
     /// Prepares self-collision for a cloth with these triangles and rest positions.
     pub fn set_cloth(&mut self, triangles: &[[usize; 3]], rest: &[Vec3]) {
         self.self_collision = Some(SelfCollision::new(triangles, rest));
+    }
+
+    /// Pins cloth `particles` (now at `x`) to mesh body `body`: each follows the body vertex
+    /// nearest to it, at its current distance along that vertex's normal.
+    pub fn pin_to_body(
+        &mut self,
+        body: usize,
+        particles: &[usize],
+        x: &[Vec3],
+    ) -> Result<(), ContactError> {
+        let Some(b) = self.bodies.get(body) else {
+            return Err(ContactError::Parameter(format!(
+                "body {body} does not exist ({} bodies)",
+                self.bodies.len()
+            )));
+        };
+        let Shape::Mesh(m) = &b.shape else {
+            return Err(ContactError::Parameter(format!(
+                "body {body} (`{}`) is not a mesh: only mesh bodies carry pins",
+                b.name
+            )));
+        };
+        for &p in particles {
+            let Some(xp) = x.get(p) else {
+                return Err(ContactError::Parameter(format!(
+                    "particle {p} out of range (cloth has {})",
+                    x.len()
+                )));
+            };
+            let (vertex, _) = m
+                .positions()
+                .iter()
+                .enumerate()
+                .map(|(i, q)| (i, (q - xp).norm_squared()))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .expect("a mesh body has vertices");
+            let offset = (xp - m.positions()[vertex]).dot(&m.vertex_normal(vertex));
+            self.pins.retain(|q| q.particle != p);
+            self.pins.push(BodyPin {
+                body,
+                particle: p,
+                vertex,
+                offset,
+            });
+        }
+        Ok(())
     }
 
     /// Before the solve of the step from `t` to `t + dt`: moves animated bodies to `t + dt` and
@@ -150,6 +212,13 @@ impl Collisions {
         self.last_impulse.resize(n, 0.0);
         for b in &mut self.bodies {
             b.advance_to(t + dt, dt);
+        }
+        for pin in &self.pins {
+            if let Some(Shape::Mesh(m)) = self.bodies.get(pin.body).map(|b| &b.shape) {
+                let target = m.positions()[pin.vertex] + m.vertex_normal(pin.vertex) * pin.offset;
+                filter.kind[pin.particle] = ParticleFilter::Fixed { target };
+                filter.any = true;
+            }
         }
         self.stats = ContactStats {
             min_distance: f64::INFINITY,
@@ -290,6 +359,23 @@ impl Collisions {
             }
         }
         self.stats.stats_ms = t1.elapsed().as_secs_f64() * 1e3;
+    }
+
+    /// Distance to bodies, penetrations and self-intersections of the cloth at `x`, computed
+    /// now (not the last step's figures).
+    pub fn report(&mut self, x: &[Vec3]) -> ContactStats {
+        let saved = self.stats;
+        self.stats = ContactStats {
+            min_distance: f64::INFINITY,
+            ..Default::default()
+        };
+        if !self.bodies.is_empty() {
+            self.body_statistics(x);
+        }
+        if let Some(sc) = self.self_collision.as_mut() {
+            self.stats.intersections = sc.count_intersections(x);
+        }
+        std::mem::replace(&mut self.stats, saved)
     }
 
     /// Moves vertices closer than half the thickness to a body back out to half the thickness

@@ -208,6 +208,12 @@ impl MeshBody {
         }
     }
 
+    /// Unit outward pseudo-normal (angle-weighted) at vertex `i`.
+    pub fn vertex_normal(&self, i: usize) -> Vec3 {
+        let n = self.vertex_normals[i];
+        n / n.norm().max(1e-300)
+    }
+
     /// Axis-aligned bounds of the current vertices.
     pub fn bounds(&self) -> (Vec3, Vec3) {
         crate::geometry::mesh::bounds(&self.positions)

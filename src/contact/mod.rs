@@ -5,6 +5,7 @@
 //! exact geometric primitives they rest on.
 
 pub mod body;
+pub mod character;
 pub mod ccd;
 pub mod collisions;
 pub mod error;
@@ -12,6 +13,7 @@ pub mod mesh_body;
 pub mod primitives;
 pub mod self_collision;
 pub mod spatial_hash;
+pub mod tessellate;
 
 pub use body::{Body, FrictionCoefficients, Proximity, Shape};
 pub use collisions::{Collisions, ContactSettings, ContactStats};

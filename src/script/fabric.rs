@@ -7,7 +7,9 @@ use std::path::Path;
 
 use rhai::{Dynamic, Engine, Map, Shared, INT};
 
-use super::convert::{count, get_field, num, to_map, update_field, update_from_map, RResult};
+use super::convert::{
+    count, get_field, num, rt_err, to_map, update_field, update_from_map, RResult,
+};
 use super::{getter, register};
 use crate::cloth::{ClothModel, FabricParameters};
 use crate::geometry::read_obj;
@@ -137,6 +139,23 @@ pub fn register(engine: &mut Engine) {
             let (nx, ny) = (count(&Dynamic::from_int(nx), "nx")?, count(&Dynamic::from_int(ny), "ny")?);
             Ok(ClothHandle(Shared::new(ClothModel::grid(w, h, nx, ny, f.0)?)))
         });
+    register!(engine, "cloth_cylinder", ["width: float", "height: float", "nx: int", "ny: int", "fabric: Fabric", "base: Array", "radius: float", "Cloth"],
+        "A `cloth_grid` wrapped around a vertical cylinder of `radius` whose bottom centre is `base`:
+the width runs around the axis (middle in front, at −y; the ends meet at the back, leaving a
+slit when the width is less than 2π·radius), the height upward. A tube or wrap skirt; the
+\"top\" edge is the upper rim.",
+        |w: Dynamic, h: Dynamic, nx: INT, ny: INT, f: Fabric, base: Dynamic, r: Dynamic| -> RResult<ClothHandle> {
+            let (w, h) = (num(&w, "width")?, num(&h, "height")?);
+            let (nx, ny) = (count(&Dynamic::from_int(nx), "nx")?, count(&Dynamic::from_int(ny), "ny")?);
+            let r = num(&r, "radius")?;
+            if !(r.is_finite() && r > 0.0) {
+                return Err(rt_err(format!("`radius` must be > 0, got {r}")));
+            }
+            let base = crate::geometry::Vec3::from(super::convert::vec3(&base, "base")?);
+            let mut model = ClothModel::grid(w, h, nx, ny, f.0)?;
+            crate::geometry::grid::wrap_on_cylinder(&mut model.mesh.positions, base, r);
+            Ok(ClothHandle(Shared::new(model)))
+        });
     register!(
         engine,
         "cloth_obj",
@@ -147,6 +166,28 @@ pub fn register(engine: &mut Engine) {
             Ok(ClothHandle(Shared::new(ClothModel::from_mesh(mesh, f.0)?)))
         }
     );
+    register!(engine, "translated", ["cloth: Cloth", "offset: Array", "Cloth"],
+        "A copy of the cloth moved by `offset` [dx, dy, dz] m (its pattern is unchanged).",
+        |c: &mut ClothHandle, d: Dynamic| -> RResult<ClothHandle> {
+            let d = crate::geometry::Vec3::from(super::convert::vec3(&d, "offset")?);
+            let mut m = (*c.0).clone();
+            m.mesh.positions.iter_mut().for_each(|p| *p += d);
+            Ok(ClothHandle(Shared::new(m)))
+        });
+    register!(engine, "rotated", ["cloth: Cloth", "axis: Array", "degrees: float", "Cloth"],
+        "A copy of the cloth turned by `degrees` about `axis` [x, y, z] through the origin
+(right-hand rule; its pattern is unchanged).",
+        |c: &mut ClothHandle, axis: Dynamic, deg: Dynamic| -> RResult<ClothHandle> {
+            let axis = crate::geometry::Vec3::from(super::convert::vec3(&axis, "axis")?);
+            let deg = num(&deg, "degrees")?;
+            let Some(unit) = nalgebra::Unit::try_new(axis, 1e-12) else {
+                return Err(rt_err("`axis` must not be zero"));
+            };
+            let r = nalgebra::Rotation3::from_axis_angle(&unit, deg.to_radians());
+            let mut m = (*c.0).clone();
+            m.mesh.positions.iter_mut().for_each(|p| *p = r * *p);
+            Ok(ClothHandle(Shared::new(m)))
+        });
     getter!(
         engine,
         "vertex_count",

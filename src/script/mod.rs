@@ -5,12 +5,14 @@
 //! - [`convert`]: error conversion, numbers and vectors, `…Parameters` ⇄ object maps;
 //! - [`fabric`]: the `Fabric` value type and the `Cloth` handle (`fabric()`, `cloth_grid`, …);
 //! - [`sim`]: the `Simulation` handle: constraints, stepping, runs with per-frame callbacks;
+//! - [`contact`]: collision bodies, the mannequin, friction, contact settings and read-outs;
 //! - [`output`]: positions, bounds, energies, OBJ/glTF/CSV/JSON/PNG output;
 //! - [`kes`]: the virtual Kawabata lab (fabric files, rigs, fitting, summaries);
 //! - [`run`], [`repl`], [`docs`]: running a file, the interactive loop, API documentation.
 //!
 //! Big objects cross into Rhai as shared handles (`Shared<Locked<_>>`), never copied per call.
 
+pub mod contact;
 pub mod convert;
 pub mod docs;
 pub mod fabric;
@@ -101,6 +103,7 @@ pub fn build_engine_with(limits: EngineLimits) -> Engine {
     });
     fabric::register(&mut engine);
     sim::register(&mut engine);
+    contact::register(&mut engine);
     output::register(&mut engine);
     kes::register(&mut engine);
     engine

@@ -8,6 +8,7 @@ use rhai::{Array, Dynamic, Engine, Map, INT};
 use super::convert::{arr3, count, finite, rt_err, to_map, RResult};
 use super::{register, SimHandle};
 use crate::cloth::{stats, Simulation};
+use crate::contact::tessellate::body_mesh;
 use crate::geometry::{mesh::bounds, write_glb, write_obj};
 use crate::render::{render_png, Camera, RenderMesh};
 
@@ -62,15 +63,30 @@ fn camera(sim: &Simulation, m: &Map) -> RResult<Camera> {
     Ok(cam)
 }
 
-/// Renders the cloth's current shape to a PNG file.
+/// Colour of collision bodies in pictures.
+const BODY_COLOR: [u8; 3] = [206, 196, 178];
+
+/// Renders the cloth's current shape and the collision bodies to a PNG file.
 fn render(sim: &Simulation, path: &str, cam: &Camera) -> RResult<()> {
     parent_dir(path)?;
-    let mesh = RenderMesh {
+    let (lo, hi) = bounds(&sim.state.x);
+    let bodies: Vec<_> = sim
+        .contact
+        .bodies
+        .iter()
+        .map(|b| body_mesh(b, &lo, &hi))
+        .collect();
+    let mut meshes = vec![RenderMesh {
         positions: &sim.state.x,
         triangles: &sim.model.mesh.triangles,
         color: RenderMesh::DEFAULT_COLOR,
-    };
-    render_png(Path::new(path), &[mesh], cam)?;
+    }];
+    meshes.extend(bodies.iter().map(|(p, t)| RenderMesh {
+        positions: p,
+        triangles: t,
+        color: BODY_COLOR,
+    }));
+    render_png(Path::new(path), &meshes, cam)?;
     Ok(())
 }
 

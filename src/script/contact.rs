@@ -1,0 +1,130 @@
+//! Script bindings for contact: collision bodies (sphere, box, plane, OBJ mesh, the animated
+//! mannequin), their friction, particles pinned to bodies, contact settings and the contact
+//! read-outs (distance to bodies, penetrations, self-intersections).
+
+use std::path::Path;
+
+use rhai::{Array, Dynamic, Engine, Map, INT};
+
+use super::convert::{finite, index, indices, rt_err, to_map, update_from_map, vec3, RResult};
+use super::{register, SimHandle};
+use crate::body::RetargetOptions;
+use crate::cloth::ClothError;
+use crate::contact::character::mannequin_body;
+use crate::contact::{Body, ContactError, ContactSettings, FrictionCoefficients, MeshBody};
+use crate::geometry::{read_obj, Vec3};
+
+fn contact_err(e: ContactError) -> Box<rhai::EvalAltResult> {
+    ClothError::Contact(e).into()
+}
+
+fn add_body(h: &SimHandle, body: Result<Body, ContactError>) -> RResult<INT> {
+    let body = body.map_err(contact_err)?;
+    let mut s = h.get_mut()?;
+    s.contact.bodies.push(body);
+    Ok((s.contact.bodies.len() - 1) as INT)
+}
+
+fn v3(d: &Dynamic, what: &str) -> RResult<Vec3> {
+    Ok(Vec3::from(vec3(d, what)?))
+}
+
+/// Where the shared data lives: `$EMILION_DATA`, else `../shared/data`.
+fn data_dir() -> std::path::PathBuf {
+    std::env::var_os("EMILION_DATA").map_or_else(|| "../shared/data".into(), Into::into)
+}
+
+/// Registers the contact functions of `Simulation`.
+pub fn register(engine: &mut Engine) {
+    register!(engine, "add_sphere", ["sim: Simulation", "center: Array", "radius: float", "int"],
+        "Adds a static solid sphere; returns its body index.",
+        |h: &mut SimHandle, c: Dynamic, r: Dynamic| -> RResult<INT> {
+            add_body(h, Body::sphere(v3(&c, "center")?, finite(&r, "radius")?))
+        });
+    register!(engine, "add_box", ["sim: Simulation", "center: Array", "size: Array", "int"],
+        "Adds a static solid axis-aligned box of full size `[sx, sy, sz]` m; returns its body index.",
+        |h: &mut SimHandle, c: Dynamic, s: Dynamic| -> RResult<INT> {
+            add_body(h, Body::cuboid(v3(&c, "center")?, v3(&s, "size")?))
+        });
+    register!(engine, "add_plane", ["sim: Simulation", "point: Array", "normal: Array", "int"],
+        "Adds a static plane through `point`; everything behind it (against `normal`) is solid.\nReturns its body index.",
+        |h: &mut SimHandle, p: Dynamic, n: Dynamic| -> RResult<INT> {
+            add_body(h, Body::plane(v3(&p, "point")?, v3(&n, "normal")?))
+        });
+    register!(engine, "add_obstacle", ["sim: Simulation", "path: String", "int"],
+        "Adds a static triangle mesh read from an OBJ file (metres) as a body. Degenerate triangles\nare dropped; a non-manifold or inconsistently wound mesh is an error naming the edge.\nReturns its body index.",
+        |h: &mut SimHandle, path: &str| -> RResult<INT> {
+            let mesh = read_obj(Path::new(path))?;
+            add_body(h, MeshBody::new(path, mesh.positions, &mesh.triangles).map(Body::mesh))
+        });
+    register!(engine, "add_mannequin", ["sim: Simulation", "options: Map", "int"],
+        "Adds the MakeHuman mannequin (feet on z = 0, facing −y) as a body, animated by a BVH clip:\n`#{motion: \"path.bvh\", in_place: true, start: 0.0, makehuman: \"dir\"}`. Without `motion`\nit stands still in its rest pose. `makehuman` defaults to `$EMILION_DATA/bodies/makehuman`\n(`$EMILION_DATA` defaults to `../shared/data`); `in_place` removes the walk's forward travel;\n`start` is the clip time at simulation time 0. Returns its body index.",
+        |h: &mut SimHandle, m: Map| -> RResult<INT> {
+            const KEYS: [&str; 4] = ["motion", "in_place", "start", "makehuman"];
+            if let Some(k) = m.keys().find(|k| !KEYS.contains(&k.as_str())) {
+                return Err(rt_err(format!("add_mannequin: unknown option `{k}` (known: {})", KEYS.join(", "))));
+            }
+            let text = |k: &str| -> RResult<Option<String>> {
+                m.get(k).map(|v| v.clone().into_string().map_err(|t| rt_err(format!("`{k}` must be a string, got {t}")))).transpose()
+            };
+            let dir = text("makehuman")?.map_or_else(|| data_dir().join("bodies/makehuman"), Into::into);
+            let motion = text("motion")?;
+            let mut opt = RetargetOptions::default();
+            if let Some(v) = m.get("in_place") {
+                opt.in_place = v.as_bool().map_err(|t| rt_err(format!("`in_place` must be true or false, got {t}")))?;
+            }
+            if let Some(v) = m.get("start") {
+                opt.start_time = finite(v, "start")?;
+            }
+            add_body(h, mannequin_body(&dir, motion.as_deref().map(Path::new), opt))
+        });
+    register!(engine, "set_friction", ["sim: Simulation", "body: int", "static: float", "kinetic: float"],
+        "Sets a body's static and kinetic friction coefficients (each combined with the fabric's by\ntheir mean; set the fabric's with `set_contact(#{friction: #{static: .., kinetic: ..}})`).",
+        |h: &mut SimHandle, b: INT, s: Dynamic, k: Dynamic| -> RResult<()> {
+            let f = FrictionCoefficients { static_: finite(&s, "static")?, kinetic: finite(&k, "kinetic")? };
+            f.validate("body friction").map_err(contact_err)?;
+            let mut sim = h.get_mut()?;
+            let n = sim.contact.bodies.len();
+            let body = sim.contact.bodies.get_mut(index(b, "body")?)
+                .ok_or_else(|| rt_err(format!("body {b} does not exist ({n} bodies)")))?;
+            body.friction = f;
+            Ok(())
+        });
+    register!(engine, "set_contact", ["sim: Simulation", "settings: Map"],
+        "Changes contact settings from a map: thickness (m, cloth–body distance), friction\n(#{static, kinetic}: the fabric's), self_collision (bool), self_thickness (m), self_friction,\nmax_push_speed (m/s), count_intersections (bool). Values are checked.",
+        |h: &mut SimHandle, m: Map| -> RResult<()> {
+            let mut sim = h.get_mut()?;
+            let s: ContactSettings = update_from_map(&sim.contact.settings, &m, "contact")?;
+            s.validate().map_err(contact_err)?;
+            sim.contact.settings = s;
+            Ok(())
+        });
+    register!(engine, "contact_settings", ["sim: Simulation", "Map"],
+        "The contact settings as a map (see `set_contact`).",
+        |h: &mut SimHandle| -> RResult<Dynamic> { Ok(to_map(&h.get()?.contact.settings)) });
+    register!(engine, "pin_to_body", ["sim: Simulation", "particles: Array", "body: int"],
+        "Makes particles follow a mesh body (e.g. a waistband on the mannequin): each keeps its\ndistance along the normal of the body vertex nearest to it now.",
+        |h: &mut SimHandle, p: Array, b: INT| -> RResult<()> {
+            let p = indices(&p, "particle")?;
+            let mut sim = h.get_mut()?;
+            let x = sim.state.x.clone();
+            sim.contact.pin_to_body(index(b, "body")?, &p, &x).map_err(contact_err)
+        });
+    register!(engine, "contact_report", ["sim: Simulation", "Map"],
+        "Contact state now: #{bodies, min_distance (m, smallest signed vertex–body distance),\npenetrating (vertices inside bodies), intersections (intersecting cloth edge–triangle pairs)}\nand the last step's #{contacts, self_contacts, collision_ms}.",
+        |h: &mut SimHandle| -> RResult<Map> {
+            let mut sim = h.get_mut()?;
+            let x = sim.state.x.clone();
+            let r = sim.contact.report(&x);
+            let st = sim.contact.stats;
+            let mut m = Map::new();
+            m.insert("bodies".into(), Dynamic::from_int(sim.contact.bodies.len() as INT));
+            m.insert("min_distance".into(), Dynamic::from_float(r.min_distance));
+            m.insert("penetrating".into(), Dynamic::from_int(r.penetrating as INT));
+            m.insert("intersections".into(), Dynamic::from_int(r.intersections as INT));
+            m.insert("contacts".into(), Dynamic::from_int(st.contacts as INT));
+            m.insert("self_contacts".into(), Dynamic::from_int(st.self_contacts as INT));
+            m.insert("collision_ms".into(), Dynamic::from_float(st.collision_ms));
+            Ok(m)
+        });
+}
