@@ -442,10 +442,8 @@ impl Simulation {
             // constraint impulses: the residual A Δv − b lies in the constrained directions
             for i in 0..self.particle_count() {
                 self.impulse[i] = match self.filter.kind[i] {
-                    ParticleFilter::Normal { .. } => {
-                        self.asm.a.row_times(i, &self.dv) - self.asm.b[i]
-                    }
-                    _ => Vec3::zeros(),
+                    ParticleFilter::Free => Vec3::zeros(),
+                    _ => self.asm.a.row_times(i, &self.dv) - self.asm.b[i],
                 };
             }
         }

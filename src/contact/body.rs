@@ -13,10 +13,12 @@ use crate::geometry::Vec3;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct FrictionCoefficients {
     /// Static coefficient μs: a sliding contact sticks when the tangential impulse needed to
-    /// stop it is at most μs times the normal impulse (`static` in files and scripts).
-    #[serde(rename = "static")]
+    /// stop it is at most μs times the normal impulse (`mu_static` in files and scripts).
+    #[serde(rename = "mu_static")]
     pub static_: f64,
-    /// Kinetic coefficient μk: a sliding contact loses μk times the normal impulse.
+    /// Kinetic coefficient μk: a sliding contact loses μk times the normal impulse
+    /// (`mu_kinetic` in files and scripts).
+    #[serde(rename = "mu_kinetic")]
     pub kinetic: f64,
 }
 

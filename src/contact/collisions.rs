@@ -22,7 +22,9 @@ use crate::geometry::Vec3;
 pub struct ContactSettings {
     /// Distance kept between the cloth and bodies (m).
     pub thickness: f64,
-    /// The fabric's friction, combined with each body's (mean of the coefficients).
+    /// The fabric's friction, combined with each body's (mean of the coefficients); its two
+    /// coefficients appear as `mu_static` and `mu_kinetic` among the settings.
+    #[serde(flatten)]
     pub friction: FrictionCoefficients,
     /// Whether the cloth collides with itself.
     pub self_collision: bool,
@@ -116,6 +118,8 @@ struct Slot {
     body: u32,
     normal: Vec3,
     velocity: Vec3,
+    /// Held fully (static friction) rather than sliding.
+    stuck: bool,
 }
 
 const NO_BODY: u32 = u32::MAX;
@@ -133,6 +137,7 @@ pub struct Collisions {
     pub pins: Vec<BodyPin>,
     slots: Vec<Slot>,
     last_impulse: Vec<f64>,
+    stuck: Vec<bool>,
     self_collision: Option<SelfCollision>,
     inv_mass: Vec<f64>,
     ms: f64,
@@ -207,9 +212,11 @@ impl Collisions {
                 body: NO_BODY,
                 normal: Vec3::zeros(),
                 velocity: Vec3::zeros(),
+                stuck: false,
             },
         );
         self.last_impulse.resize(n, 0.0);
+        self.stuck.resize(n, false);
         for b in &mut self.bodies {
             b.advance_to(t + dt, dt);
         }
@@ -261,6 +268,7 @@ impl Collisions {
         for (i, f) in found.into_iter().enumerate() {
             let Some((k, p)) = f else {
                 self.last_impulse[i] = 0.0;
+                self.stuck[i] = false;
                 continue;
             };
             if matches!(filter.kind[i], ParticleFilter::Fixed { .. }) {
@@ -268,11 +276,21 @@ impl Collisions {
             }
             // end exactly at the thickness, never pushing out faster than max_push
             let vn = ((h - p.distance) / dt).min(p.velocity.dot(&p.normal) + max_push);
-            filter.constrain_normal(i, p.normal, vn);
+            let stuck = self.stuck[i] && self.last_impulse[i] > 0.0;
+            if stuck {
+                // static friction inside the solve: the particle moves with the surface
+                let vt_body = p.velocity - p.normal * p.normal.dot(&p.velocity);
+                let target = x[i] + (vt_body + p.normal * vn) * dt;
+                filter.kind[i] = ParticleFilter::Fixed { target };
+                filter.any = true;
+            } else {
+                filter.constrain_normal(i, p.normal, vn);
+            }
             self.slots[i] = Slot {
                 body: k,
                 normal: p.normal,
                 velocity: p.velocity,
+                stuck,
             };
             self.stats.contacts += 1;
         }
@@ -297,24 +315,33 @@ impl Collisions {
         let t0 = Instant::now();
         let n = x.len();
         let h = self.settings.thickness;
-        // friction at body contacts
+        // friction at body contacts: a held particle stays held while the tangential impulse
+        // that holds it is within μs times the normal one; a sliding particle loses μk times the
+        // normal impulse of tangential momentum and is held from the next step if that stops it
         for i in 0..n {
             let s = self.slots[i];
-            if s.body == NO_BODY || !matches!(filter.kind[i], ParticleFilter::Normal { .. }) {
+            if s.body == NO_BODY {
                 continue;
             }
             let jn = s.normal.dot(&impulse[i]);
             self.last_impulse[i] = jn;
             if jn <= 0.0 {
+                self.stuck[i] = false;
                 continue;
             }
             let mu = self.settings.friction.combine(&self.bodies[s.body as usize].friction);
+            if s.stuck {
+                let jt = (impulse[i] - s.normal * jn).norm();
+                self.stuck[i] = jt <= mu.static_ * jn;
+                continue;
+            }
             let rel = v[i] - s.velocity;
             let vn = s.normal * s.normal.dot(&rel);
             let vt = rel - vn;
             let speed = vt.norm();
             let dv = jn / mass[i];
-            let vt_new = if speed <= mu.static_ * dv {
+            self.stuck[i] = speed <= mu.static_ * dv;
+            let vt_new = if self.stuck[i] {
                 Vec3::zeros()
             } else {
                 vt * (1.0 - mu.kinetic * dv / speed).max(0.0)

@@ -79,7 +79,7 @@ pub fn register(engine: &mut Engine) {
             add_body(h, mannequin_body(&dir, motion.as_deref().map(Path::new), opt))
         });
     register!(engine, "set_friction", ["sim: Simulation", "body: int", "static: float", "kinetic: float"],
-        "Sets a body's static and kinetic friction coefficients (each combined with the fabric's by\ntheir mean; set the fabric's with `set_contact(#{friction: #{static: .., kinetic: ..}})`).",
+        "Sets a body's static and kinetic friction coefficients (each combined with the fabric's by\ntheir mean; set the fabric's with `set_contact(#{mu_static: .., mu_kinetic: ..})`).",
         |h: &mut SimHandle, b: INT, s: Dynamic, k: Dynamic| -> RResult<()> {
             let f = FrictionCoefficients { static_: finite(&s, "static")?, kinetic: finite(&k, "kinetic")? };
             f.validate("body friction").map_err(contact_err)?;
@@ -91,7 +91,7 @@ pub fn register(engine: &mut Engine) {
             Ok(())
         });
     register!(engine, "set_contact", ["sim: Simulation", "settings: Map"],
-        "Changes contact settings from a map: thickness (m, cloth–body distance), friction\n(#{static, kinetic}: the fabric's), self_collision (bool), self_thickness (m), self_friction,\nmax_push_speed (m/s), count_intersections (bool). Values are checked.",
+        "Changes contact settings from a map: thickness (m, cloth–body distance), friction of\nthe fabric (mu_static, mu_kinetic), self_collision (bool), self_thickness (m), self_friction,\nmax_push_speed (m/s), count_intersections (bool). Values are checked.",
         |h: &mut SimHandle, m: Map| -> RResult<()> {
             let mut sim = h.get_mut()?;
             let s: ContactSettings = update_from_map(&sim.contact.settings, &m, "contact")?;
