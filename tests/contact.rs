@@ -53,3 +53,48 @@ fn cloth_on_incline_sticks_below_friction_angle_and_slides_above() {
     assert!(below.abs() < 2e-3, "slid {below} m below the friction angle");
     assert!(above > 0.5 * expect, "slid only {above} m above the friction angle");
 }
+
+fn exact_intersections(x: &[Vec3], tris: &[[usize; 3]]) -> usize {
+    let p: Vec<[f64; 3]> = x.iter().map(|v| [v.x, v.y, v.z]).collect();
+    support::intersections::count_edge_triangle_intersections(&p, tris)
+}
+
+/// Regression: the engine's fast intersection count took coplanar cells of a cylinder for
+/// crossings (its line test ran on round-off signs).
+#[test]
+fn cylinder_and_cone_cloths_do_not_intersect_themselves() {
+    for (rt, rb) in [(0.22, 0.22), (0.16, 0.26)] {
+        let mesh = emilion::geometry::cone::cone_mesh(rt, rb, 0.5, 64, 20, Vec3::new(0.0, 0.0, 0.5), 0.05)
+            .unwrap();
+        let model = ClothModel::from_mesh(mesh, FabricParameters::default()).unwrap();
+        check_no_self_intersection(model);
+    }
+}
+
+fn check_no_self_intersection(model: ClothModel) {
+    let exact = exact_intersections(&model.mesh.positions, &model.mesh.triangles);
+    let mut sim = Simulation::new(model, SimulationParameters::default()).unwrap();
+    let x = sim.state.x.clone();
+    let fast = sim.contact.report(&x).intersections;
+    assert_eq!(exact, 0);
+    assert_eq!(fast, 0);
+}
+
+#[test]
+#[ignore]
+fn probe_obj_intersections() {
+    let path = std::env::var("PROBE_OBJ").unwrap();
+    let m = emilion::geometry::read_obj(std::path::Path::new(&path)).unwrap();
+    let p: Vec<[f64; 3]> = m.positions.iter().map(|v| [v.x, v.y, v.z]).collect();
+    println!("exact {}", support::intersections::count_edge_triangle_intersections(&p, &m.triangles));
+    let mut k = 0;
+    for (a, b) in support::intersections::unique_edges(&m.triangles) {
+        for t in &m.triangles {
+            if t.contains(&a) || t.contains(&b) { continue; }
+            if support::intersections::segment_triangle_intersect_exact(p[a], p[b], p[t[0]], p[t[1]], p[t[2]]) {
+                if k < 6 { println!("edge {a}-{b} tri {t:?}"); }
+                k += 1;
+            }
+        }
+    }
+}

@@ -41,6 +41,9 @@ pub struct RetargetOptions {
     pub in_place: bool,
     /// Clip time (seconds) that animation time 0 maps to. Default 0.
     pub start_time: f64,
+    /// Extra outward tilt of the upper arms (degrees), for mannequins whose hips are wider than
+    /// the captured actor's (the hands would otherwise brush through them). Default 0.
+    pub arm_spread_deg: f64,
 }
 
 impl Default for RetargetOptions {
@@ -48,6 +51,7 @@ impl Default for RetargetOptions {
         RetargetOptions {
             in_place: true,
             start_time: 0.0,
+            arm_spread_deg: 0.0,
         }
     }
 }
@@ -192,8 +196,14 @@ fn swing(d: Vec3, e: Vec3) -> UnitQuaternion<f64> {
 enum Drive {
     /// Follows its parent rigidly.
     Follow,
-    /// Swung from rest direction `dir` (unit) to BVH joints `from → to`.
-    Swing { dir: Vec3, from: usize, to: usize },
+    /// Swung from rest direction `dir` (unit) to BVH joints `from → to`, tilted outward by
+    /// `spread` (tangent of the angle, signed by side) along the parent's lateral axis.
+    Swing {
+        dir: Vec3,
+        from: usize,
+        to: usize,
+        spread: f64,
+    },
     /// Full orientation from a frame of four points (rest frame of the mannequin, BVH joints).
     Frame {
         rest: Matrix3<f64>,
@@ -274,10 +284,17 @@ impl Animation {
                             format!("bone '{}' has no length", sub(bone)),
                         )
                     })?;
+                let sign = if side == "L" { 1.0 } else { -1.0 };
+                let spread = if bone.starts_with("upperarm") {
+                    sign * options.arm_spread_deg.to_radians().tan()
+                } else {
+                    0.0
+                };
                 drives[b] = Drive::Swing {
                     dir,
                     from: bvh(&sub(from))?,
                     to: bvh(&sub(to))?,
+                    spread,
                 };
                 swings.push(SwingMap {
                     bone: sub(bone),
@@ -491,8 +508,16 @@ fn pose_for_frame(
         };
         match drives[b] {
             Drive::Follow => {}
-            Drive::Swing { dir, from, to } => {
-                if let Some(e) = (p[to] - p[from]).try_normalize(1e-12) {
+            Drive::Swing {
+                dir,
+                from,
+                to,
+                spread,
+            } => {
+                let lateral = r * Vec3::x() * spread;
+                if let Some(e) = (p[to] - p[from] + lateral * (p[to] - p[from]).norm())
+                    .try_normalize(1e-12)
+                {
                     r = swing(r * dir, e) * r;
                 }
             }

@@ -98,8 +98,8 @@ pub struct ContactStats {
     pub stats_ms: f64,
 }
 
-/// A cloth particle held at a fixed distance along the normal of a mesh body's vertex, so that
-/// it follows the (animated) body: a waistband on a character.
+/// A cloth particle held at a fixed offset from a mesh body's vertex, the offset turning with
+/// the vertex normal, so that it follows the (animated) body: a waistband on a character.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BodyPin {
     /// The body (a mesh).
@@ -108,8 +108,36 @@ pub struct BodyPin {
     pub particle: usize,
     /// The body vertex it follows.
     pub vertex: usize,
-    /// Distance along the vertex normal (m).
-    pub offset: f64,
+    /// Offset from the vertex when pinned (m).
+    pub offset: Vec3,
+    /// The vertex normal when pinned.
+    pub normal: Vec3,
+    /// Optional snap onto the body: the offset eases to `gap` along the normal between
+    /// times `from` and `to` (s): (gap, from, to).
+    pub snap: Option<(f64, f64, f64)>,
+}
+
+impl BodyPin {
+    /// Where the particle goes at time `t` when the vertex is at `p` with unit normal `n`.
+    pub fn target(&self, p: &Vec3, n: &Vec3, t: f64) -> Vec3 {
+        let turn = nalgebra::Rotation3::rotation_between(&self.normal, n)
+            .unwrap_or_else(nalgebra::Rotation3::identity);
+        let offset = match self.snap {
+            Some((gap, from, to)) => {
+                let s = if to > from {
+                    ((t - from) / (to - from)).clamp(0.0, 1.0)
+                } else if t >= to {
+                    1.0
+                } else {
+                    0.0
+                };
+                let w = s * s * (3.0 - 2.0 * s);
+                self.offset * (1.0 - w) + self.normal * (gap * w)
+            }
+            None => self.offset,
+        };
+        p + turn * offset
+    }
 }
 
 /// Per-vertex body contact of the current step.
@@ -138,6 +166,8 @@ pub struct Collisions {
     slots: Vec<Slot>,
     last_impulse: Vec<f64>,
     stuck: Vec<bool>,
+    /// Per vertex: how deep inside a body it was at the last statistics pass (m, 0 outside).
+    depth: Vec<f64>,
     self_collision: Option<SelfCollision>,
     inv_mass: Vec<f64>,
     ms: f64,
@@ -155,13 +185,24 @@ impl Collisions {
     }
 
     /// Pins cloth `particles` (now at `x`) to mesh body `body`: each follows the body vertex
-    /// nearest to it, at its current distance along that vertex's normal.
+    /// nearest to it in the body's rest pose (so that a waistband picks the waist, not a hand
+    /// swinging by), keeping its present offset from it, turned with the vertex normal. With
+    /// `snap = Some((gap, from, to))` the offset eases between times `from` and `to` to `gap`
+    /// along the vertex normal: the particles are drawn onto the body (a gathered waistband).
     pub fn pin_to_body(
         &mut self,
         body: usize,
         particles: &[usize],
         x: &[Vec3],
+        snap: Option<(f64, f64, f64)>,
     ) -> Result<(), ContactError> {
+        if let Some((gap, from, to)) = snap {
+            if !(gap.is_finite() && gap >= 0.0 && from.is_finite() && to.is_finite() && to >= from) {
+                return Err(ContactError::Parameter(format!(
+                    "pin_to_body: snap needs gap >= 0 and from <= to, got gap {gap}, from {from}, to {to}"
+                )));
+            }
+        }
         let Some(b) = self.bodies.get(body) else {
             return Err(ContactError::Parameter(format!(
                 "body {body} does not exist ({} bodies)",
@@ -182,19 +223,21 @@ impl Collisions {
                 )));
             };
             let (vertex, _) = m
-                .positions()
+                .rest_positions()
                 .iter()
                 .enumerate()
                 .map(|(i, q)| (i, (q - xp).norm_squared()))
                 .min_by(|a, b| a.1.total_cmp(&b.1))
                 .expect("a mesh body has vertices");
-            let offset = (xp - m.positions()[vertex]).dot(&m.vertex_normal(vertex));
+            let offset = xp - m.positions()[vertex];
             self.pins.retain(|q| q.particle != p);
             self.pins.push(BodyPin {
                 body,
                 particle: p,
                 vertex,
                 offset,
+                normal: m.vertex_normal(vertex),
+                snap,
             });
         }
         Ok(())
@@ -222,7 +265,8 @@ impl Collisions {
         }
         for pin in &self.pins {
             if let Some(Shape::Mesh(m)) = self.bodies.get(pin.body).map(|b| &b.shape) {
-                let target = m.positions()[pin.vertex] + m.vertex_normal(pin.vertex) * pin.offset;
+                let target =
+                    pin.target(&m.positions()[pin.vertex], &m.vertex_normal(pin.vertex), t + dt);
                 filter.kind[pin.particle] = ParticleFilter::Fixed { target };
                 filter.any = true;
             }
@@ -239,11 +283,12 @@ impl Collisions {
         let bodies = &self.bodies;
         let bounds: Vec<(Vec3, Vec3)> = bodies.iter().map(|b| b.bounds()).collect();
         let last = &self.last_impulse;
+        let depth = &self.depth;
         let found: Vec<Option<(u32, Proximity)>> = (0..n)
             .into_par_iter()
             .with_min_len(256)
             .map(|i| {
-                let reach = 1.5 * h + v[i].norm() * dt;
+                let reach = 1.5 * h + v[i].norm() * dt + depth.get(i).copied().unwrap_or(0.0);
                 let mut best: Option<(u32, Proximity, f64)> = None;
                 for (k, b) in bodies.iter().enumerate() {
                     let (lo, hi) = &bounds[k];
@@ -351,12 +396,14 @@ impl Collisions {
         }
         // push-out (Provot) and body statistics
         if !self.bodies.is_empty() {
-            self.push_out(x, v, filter, h);
+            self.push_out(x, v, filter, 0.5 * h, None);
         }
         // cloth–cloth
         if self.settings.self_collision {
             if let Some(sc) = self.self_collision.as_mut() {
                 self.inv_mass.clear();
+                // particles held by pins or bodies are not moved by cloth–cloth impulses: the
+                // free layer gives way, so nothing is pushed into a body
                 self.inv_mass.extend((0..n).map(|i| match filter.kind[i] {
                     ParticleFilter::Fixed { .. } => 0.0,
                     _ => 1.0 / mass[i],
@@ -370,6 +417,10 @@ impl Collisions {
                     self.settings.self_thickness,
                     self.settings.self_friction,
                 );
+                if !self.bodies.is_empty() && sc.moved_any() {
+                    let moved = sc.moved().to_vec();
+                    self.push_out(x, v, filter, 0.1 * h, Some(&moved));
+                }
                 self.stats.self_contacts = rep.proximities;
                 self.stats.ccd_hits = rep.ccd_hits;
                 self.stats.zone_rounds = rep.zone_rounds;
@@ -405,26 +456,36 @@ impl Collisions {
         std::mem::replace(&mut self.stats, saved)
     }
 
-    /// Moves vertices closer than half the thickness to a body back out to half the thickness
-    /// and removes their approaching normal velocity.
-    fn push_out(&self, x: &mut [Vec3], v: &mut [Vec3], filter: &Filter, h: f64) {
+    /// Moves vertices closer than `target` to a body back out to `target` and removes their
+    /// approaching normal velocity. Only vertices with `only[i]` when given. Vertices found
+    /// inside a body at the last statistics pass are searched that deep.
+    fn push_out(
+        &self,
+        x: &mut [Vec3],
+        v: &mut [Vec3],
+        filter: &Filter,
+        target: f64,
+        only: Option<&[bool]>,
+    ) {
         let bodies = &self.bodies;
-        let target = 0.5 * h;
+        let depth = &self.depth;
+        let h = self.settings.thickness;
         x.par_iter_mut()
             .zip(v.par_iter_mut())
             .enumerate()
             .with_min_len(256)
             .for_each(|(i, (xi, vi))| {
-                if matches!(filter.kind[i], ParticleFilter::Fixed { .. }) {
+                if matches!(filter.kind[i], ParticleFilter::Fixed { .. })
+                    || only.is_some_and(|o| !o[i])
+                {
                     return;
                 }
+                let reach = h + depth.get(i).copied().unwrap_or(0.0);
                 for b in bodies {
                     let (lo, hi) = b.bounds();
-                    if (0..3).any(|a| xi[a] < lo[a] - h || xi[a] > hi[a] + h) {
+                    if (0..3).any(|a| xi[a] < lo[a] - reach || xi[a] > hi[a] + reach) {
                         continue;
                     }
-                    let inside_box = (0..3).all(|a| xi[a] >= lo[a] && xi[a] <= hi[a]);
-                    let reach = if inside_box { f64::INFINITY } else { h };
                     if let Some(p) = b.proximity(xi, reach) {
                         if p.distance < target {
                             *xi += p.normal * (target - p.distance);
@@ -441,10 +502,11 @@ impl Collisions {
     fn body_statistics(&mut self, x: &[Vec3]) {
         let bodies = &self.bodies;
         let h = self.settings.thickness;
-        let (min, inside) = x
-            .par_iter()
+        self.depth.resize(x.len(), 0.0);
+        x.par_iter()
+            .zip(self.depth.par_iter_mut())
             .with_min_len(256)
-            .map(|xi| {
+            .for_each(|(xi, di)| {
                 let mut m = f64::INFINITY;
                 for b in bodies {
                     let (lo, hi) = b.bounds();
@@ -455,13 +517,31 @@ impl Collisions {
                         m = m.min(p.distance);
                     }
                 }
-                (m, usize::from(m < 0.0))
-            })
-            .reduce(
-                || (f64::INFINITY, 0),
-                |a, b| (a.0.min(b.0), a.1 + b.1),
-            );
+                // the signed distance, negated, for the reduction below
+                *di = if m.is_finite() { -m } else { f64::NEG_INFINITY };
+            });
+        let (min, inside) = self
+            .depth
+            .iter()
+            .fold((f64::INFINITY, 0), |(m, k), &d| (m.min(-d), k + usize::from(d > 0.0)));
+        for d in &mut self.depth {
+            *d = d.max(0.0);
+        }
         self.stats.min_distance = min;
         self.stats.penetrating = inside;
+        if inside > 0 && std::env::var_os("EMILION_DEBUG_CONTACT").is_some() {
+            for (i, xi) in x.iter().enumerate() {
+                for b in bodies {
+                    if let Some(p) = b.proximity(xi, f64::INFINITY) {
+                        if p.distance < 0.0 {
+                            eprintln!(
+                                "inside: vertex {i} at {:.3?} depth {:.4} normal {:.2?} slot body {} stuck {} filter-last {:.3e}",
+                                xi.as_slice(), p.distance, p.normal.as_slice(), self.slots[i].body as i64, self.slots[i].stuck, self.last_impulse[i]
+                            );
+                        }
+                    }
+                }
+            }
+        }
     }
 }

@@ -26,6 +26,7 @@ pub struct MeshBody {
     /// Name for messages (the file name for meshes read from disk).
     pub name: String,
     positions: Vec<Vec3>,
+    rest: Vec<Vec3>,
     velocities: Vec<Vec3>,
     triangles: Vec<[usize; 3]>,
     /// For each triangle and each of its edges (ab, bc, ca) the triangle across, if any.
@@ -135,6 +136,7 @@ impl MeshBody {
             velocities: vec![Vec3::zeros(); n],
             face_normals: vec![Vec3::zeros(); tris.len()],
             vertex_normals: vec![Vec3::zeros(); n],
+            rest: positions.clone(),
             positions,
             triangles: tris,
             across,
@@ -170,6 +172,11 @@ impl MeshBody {
     /// Current vertex positions.
     pub fn positions(&self) -> &[Vec3] {
         &self.positions
+    }
+
+    /// Vertex positions the mesh was built with (an animated character's rest pose).
+    pub fn rest_positions(&self) -> &[Vec3] {
+        &self.rest
     }
 
     /// Triangles (outward winding when the mesh is closed).

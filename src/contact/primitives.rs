@@ -300,15 +300,23 @@ const PROJECTIONS: [(usize, usize); 3] = [(1, 2), (2, 0), (0, 1)];
 /// a segment lying in the triangle's plane is tested in 2D along the dominant normal axis;
 /// a zero-area triangle is treated as the union of its edges.
 pub fn segment_triangle_intersect(p0: Vec3, p1: Vec3, a: Vec3, b: Vec3, c: Vec3) -> bool {
-    let op = orient3d_f64(&a, &b, &c, &p0);
-    let oq = orient3d_f64(&a, &b, &c, &p1);
+    // orientations within round-off of zero count as zero: a segment lying in the triangle's
+    // plane must take the 2D test, not the line test, whose signs are then noise
+    let scale = [b - a, c - a, p0 - a, p1 - a]
+        .iter()
+        .map(|v| v.amax())
+        .fold(0.0, f64::max);
+    let tol = 1e-12 * scale * scale * scale;
+    let snap = |o: f64| if o.abs() <= tol { 0.0 } else { o };
+    let op = snap(orient3d_f64(&a, &b, &c, &p0));
+    let oq = snap(orient3d_f64(&a, &b, &c, &p1));
     if (op > 0.0 && oq > 0.0) || (op < 0.0 && oq < 0.0) {
         return false;
     }
     if op != 0.0 || oq != 0.0 {
-        let s1 = orient3d_f64(&p0, &p1, &a, &b);
-        let s2 = orient3d_f64(&p0, &p1, &b, &c);
-        let s3 = orient3d_f64(&p0, &p1, &c, &a);
+        let s1 = snap(orient3d_f64(&p0, &p1, &a, &b));
+        let s2 = snap(orient3d_f64(&p0, &p1, &b, &c));
+        let s3 = snap(orient3d_f64(&p0, &p1, &c, &a));
         let any_pos = s1 > 0.0 || s2 > 0.0 || s3 > 0.0;
         let any_neg = s1 < 0.0 || s2 < 0.0 || s3 < 0.0;
         return !(any_pos && any_neg);

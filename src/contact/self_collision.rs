@@ -23,6 +23,8 @@ use crate::geometry::{Mat3, Vec3};
 const CCD_PASSES: usize = 6;
 /// Impact-zone rounds before the last-resort stop.
 const ZONE_ROUNDS: usize = 24;
+/// Largest rotation (rad) of an impact zone in one step.
+const MAX_TURN: f64 = 0.2;
 /// Pairs are left this fraction of the thickness apart after a continuous hit.
 const SEPARATION: f64 = 0.25;
 /// Fraction of the overlap recovered per step by the repulsion push.
@@ -41,6 +43,8 @@ pub struct SelfCollisionReport {
     pub zone_rounds: usize,
     /// Vertices stopped by the last resort.
     pub stopped: usize,
+    /// Crossing pairs left unresolved (the start of the step was already tangled).
+    pub unresolved: usize,
 }
 
 /// Self-collision topology and workspaces of one cloth.
@@ -58,6 +62,7 @@ pub struct SelfCollision {
     d: Vec<Vec3>,
     d_in: Vec<Vec3>,
     d_bp: Vec<Vec3>,
+    moved: Vec<bool>,
     parent: Vec<u32>,
 }
 
@@ -94,8 +99,19 @@ impl SelfCollision {
             d: Vec::new(),
             d_in: Vec::new(),
             d_bp: Vec::new(),
+            moved: Vec::new(),
             parent: Vec::new(),
         }
+    }
+
+    /// Which vertices the last [`SelfCollision::respond`] moved.
+    pub fn moved(&self) -> &[bool] {
+        &self.moved
+    }
+
+    /// Whether the last [`SelfCollision::respond`] moved any vertex.
+    pub fn moved_any(&self) -> bool {
+        self.moved.iter().any(|&m| m)
     }
 
     /// Unique undirected edges of the cloth.
@@ -196,15 +212,30 @@ impl SelfCollision {
         if u >= target {
             return 0.0;
         }
+        Self::impulse(d, inv_mass, vs, w, n, target - u);
+        target - u
+    }
+
+    /// Changes the weighted relative displacement of `vs` along unit `dir` by `change`, each
+    /// vertex in proportion to its weight and inverse mass. When the free vertices carry little
+    /// weight (the pair's other vertices are held), no vertex moves more than twice `change`:
+    /// the pair is then left to the impact zones rather than flung apart.
+    fn impulse(d: &mut [Vec3], inv_mass: &[f64], vs: &[usize; 4], w: &[f64; 4], dir: &Vec3, change: f64) {
         let den: f64 = (0..4).map(|k| w[k] * w[k] * inv_mass[vs[k]]).sum();
         if den <= 0.0 {
-            return 0.0;
+            return;
         }
-        let lambda = (target - u) / den;
+        let mut lambda = change / den;
+        let biggest = (0..4)
+            .map(|k| (w[k] * inv_mass[vs[k]] * lambda).abs())
+            .fold(0.0, f64::max);
+        let limit = 2.0 * change.abs();
+        if biggest > limit {
+            lambda *= limit / biggest;
+        }
         for k in 0..4 {
-            d[vs[k]] += n * (w[k] * inv_mass[vs[k]] * lambda);
+            d[vs[k]] += dir * (w[k] * inv_mass[vs[k]] * lambda);
         }
-        target - u
     }
 
     /// Resolves cloth–cloth contact on the step from `x0` (intersection-free) to `x1`: `x1`
@@ -255,16 +286,8 @@ impl SelfCollision {
                 let tang = rel - nrm * nrm.dot(&rel);
                 let len = tang.norm();
                 if len > 1e-15 {
-                    let t = tang / len;
                     let goal = (len - friction * dn).max(0.0);
-                    let u = len;
-                    let den: f64 = (0..4).map(|k| w[k] * w[k] * inv_mass[vs[k]]).sum();
-                    if den > 0.0 {
-                        let lambda = (goal - u) / den;
-                        for k in 0..4 {
-                            self.d[vs[k]] += t * (w[k] * inv_mass[vs[k]] * lambda);
-                        }
-                    }
+                    Self::impulse(&mut self.d, inv_mass, &vs, &w, &(tang / len), goal - len);
                 }
             }
         }
@@ -332,23 +355,38 @@ impl SelfCollision {
             if !resolved {
                 // last resort: everything in a zone stays where it was
                 for (_, i) in self.zone_members() {
-                    self.d[i as usize] = Vec3::zeros();
-                    rep.stopped += 1;
+                    if inv_mass[i as usize] > 0.0 {
+                        self.d[i as usize] = Vec3::zeros();
+                        rep.stopped += 1;
+                    }
                 }
                 self.broad_phase(x0, pad);
                 self.find_hits(x0, thickness, &mut hits);
                 if !hits.is_empty() {
+                    // the guarantee: nothing moves, and x0 had no crossing. (Only a start that
+                    // was already tangled can get here; it then stays as it was this step.)
+                    rep.unresolved = hits.len();
                     rep.stopped = n;
-                    self.d.fill(Vec3::zeros());
+                    for i in 0..n {
+                        if inv_mass[i] > 0.0 {
+                            self.d[i] = Vec3::zeros();
+                        }
+                    }
                 }
             }
         }
 
+        if debug && (rep.zone_rounds > 0 || rep.stopped > 0) {
+            eprintln!("self: {rep:?}");
+        }
+        self.moved.clear();
+        self.moved.resize(n, false);
         for i in 0..n {
             let change = self.d[i] - self.d_in[i];
             if change != Vec3::zeros() {
                 x1[i] = x0[i] + self.d[i];
                 v[i] += change / dt;
+                self.moved[i] = true;
             }
         }
         rep
@@ -474,9 +512,16 @@ impl SelfCollision {
             l += (r.cross(&(self.d[i] - dc))) * mass(i);
             inertia += (Mat3::identity() * r.norm_squared() - r * r.transpose()) * mass(i);
         }
+        // a nearly collinear zone has a nearly singular inertia: solve in the least-squares
+        // sense, and never turn a zone by more than MAX_TURN in one step
         let omega = inertia
-            .try_inverse()
+            .pseudo_inverse(1e-9 * inertia.norm())
             .map_or(Vec3::zeros(), |inv| inv * l);
+        let omega = if omega.norm() > MAX_TURN {
+            omega * (MAX_TURN / omega.norm())
+        } else {
+            omega
+        };
         let rot = Rotation3::new(omega);
         for &i in zone {
             let r = x0[i] - c;

@@ -48,15 +48,3 @@ pub fn grid_mesh(width: f64, height: f64, nx: usize, ny: usize) -> Result<TriMes
     })
 }
 
-/// Wraps a flat cloth lying in the XY plane around a vertical cylinder of `radius` whose
-/// bottom centre is `base`: x becomes arc length around the axis (the middle of the cloth in
-/// front, at −y; the two x ends meet at the back, leaving a slit when the width is less than the
-/// circumference) and y height above `base` (the lowest row at `base.z`).
-pub fn wrap_on_cylinder(positions: &mut [Vec3], base: Vec3, radius: f64) {
-    let (lo, hi) = super::mesh::bounds(positions);
-    let mid = 0.5 * (lo.x + hi.x);
-    for p in positions.iter_mut() {
-        let phi = (p.x - mid) / radius;
-        *p = base + Vec3::new(radius * phi.sin(), -radius * phi.cos(), p.y - lo.y);
-    }
-}

@@ -1,6 +1,7 @@
 //! Geometry: triangle meshes with rest (pattern) coordinates, grid generators, edge/hinge
 //! adjacency, and mesh file I/O (OBJ read/write, binary glTF write).
 
+pub mod cone;
 pub mod error;
 pub(crate) mod files;
 pub mod gltf;

@@ -58,9 +58,10 @@ pub fn register(engine: &mut Engine) {
             add_body(h, MeshBody::new(path, mesh.positions, &mesh.triangles).map(Body::mesh))
         });
     register!(engine, "add_mannequin", ["sim: Simulation", "options: Map", "int"],
-        "Adds the MakeHuman mannequin (feet on z = 0, facing −y) as a body, animated by a BVH clip:\n`#{motion: \"path.bvh\", in_place: true, start: 0.0, makehuman: \"dir\"}`. Without `motion`\nit stands still in its rest pose. `makehuman` defaults to `$EMILION_DATA/bodies/makehuman`\n(`$EMILION_DATA` defaults to `../shared/data`); `in_place` removes the walk's forward travel;\n`start` is the clip time at simulation time 0. Returns its body index.",
+        "Adds the MakeHuman mannequin (feet on z = 0, facing −y) as a body, animated by a BVH clip:\n`#{motion: \"path.bvh\", in_place: true, start: 0.0, blend: 0.0, makehuman: \"dir\"}`. Without\n`motion` it stands still in its rest pose. With `blend` > 0 it moves from its rest pose into the\nclip's first frame over `blend` seconds before the clip plays (dress it at rest, then move);
+`arm_spread` (degrees) tilts the upper arms outward so the hands clear wide hips. `makehuman` defaults to `$EMILION_DATA/bodies/makehuman`\n(`$EMILION_DATA` defaults to `../shared/data`); `in_place` removes the walk's forward travel;\n`start` is the clip time at simulation time 0. Returns its body index.",
         |h: &mut SimHandle, m: Map| -> RResult<INT> {
-            const KEYS: [&str; 4] = ["motion", "in_place", "start", "makehuman"];
+            const KEYS: [&str; 6] = ["motion", "in_place", "start", "makehuman", "blend", "arm_spread"];
             if let Some(k) = m.keys().find(|k| !KEYS.contains(&k.as_str())) {
                 return Err(rt_err(format!("add_mannequin: unknown option `{k}` (known: {})", KEYS.join(", "))));
             }
@@ -76,7 +77,11 @@ pub fn register(engine: &mut Engine) {
             if let Some(v) = m.get("start") {
                 opt.start_time = finite(v, "start")?;
             }
-            add_body(h, mannequin_body(&dir, motion.as_deref().map(Path::new), opt))
+            if let Some(v) = m.get("arm_spread") {
+                opt.arm_spread_deg = finite(v, "arm_spread")?;
+            }
+            let blend = m.get("blend").map_or(Ok(0.0), |v| finite(v, "blend"))?;
+            add_body(h, mannequin_body(&dir, motion.as_deref().map(Path::new), opt, blend))
         });
     register!(engine, "set_friction", ["sim: Simulation", "body: int", "static: float", "kinetic: float"],
         "Sets a body's static and kinetic friction coefficients (each combined with the fabric's by\ntheir mean; set the fabric's with `set_contact(#{mu_static: .., mu_kinetic: ..})`).",
@@ -103,12 +108,26 @@ pub fn register(engine: &mut Engine) {
         "The contact settings as a map (see `set_contact`).",
         |h: &mut SimHandle| -> RResult<Dynamic> { Ok(to_map(&h.get()?.contact.settings)) });
     register!(engine, "pin_to_body", ["sim: Simulation", "particles: Array", "body: int"],
-        "Makes particles follow a mesh body (e.g. a waistband on the mannequin): each keeps its\ndistance along the normal of the body vertex nearest to it now.",
+        "Makes particles follow a mesh body (e.g. a waistband on the mannequin): each keeps its\npresent offset from the body vertex nearest to it (in the body's rest pose), turning with it.",
         |h: &mut SimHandle, p: Array, b: INT| -> RResult<()> {
             let p = indices(&p, "particle")?;
             let mut sim = h.get_mut()?;
             let x = sim.state.x.clone();
-            sim.contact.pin_to_body(index(b, "body")?, &p, &x).map_err(contact_err)
+            sim.contact.pin_to_body(index(b, "body")?, &p, &x, None).map_err(contact_err)
+        });
+    register!(engine, "pin_to_body", ["sim: Simulation", "particles: Array", "body: int", "snap: Map"],
+        "As `pin_to_body`, and draws the particles onto the body: `#{gap: 0.006, from: 0.0, to: 0.5}`\neases each offset, between simulation times `from` and `to` (s), to `gap` m along the body\nnormal (a waistband gathered onto the waist).",
+        |h: &mut SimHandle, p: Array, b: INT, m: Map| -> RResult<()> {
+            const KEYS: [&str; 3] = ["gap", "from", "to"];
+            if let Some(k) = m.keys().find(|k| !KEYS.contains(&k.as_str())) {
+                return Err(rt_err(format!("pin_to_body: unknown snap key `{k}` (known: {})", KEYS.join(", "))));
+            }
+            let get = |k: &str| m.get(k).ok_or_else(|| rt_err(format!("pin_to_body: snap needs `{k}`"))).and_then(|v| finite(v, k));
+            let snap = (get("gap")?, get("from")?, get("to")?);
+            let p = indices(&p, "particle")?;
+            let mut sim = h.get_mut()?;
+            let x = sim.state.x.clone();
+            sim.contact.pin_to_body(index(b, "body")?, &p, &x, Some(snap)).map_err(contact_err)
         });
     register!(engine, "contact_report", ["sim: Simulation", "Map"],
         "Contact state now: #{bodies, min_distance (m, smallest signed vertex–body distance),\npenetrating (vertices inside bodies), intersections (intersecting cloth edge–triangle pairs)}\nand the last step's #{contacts, self_contacts, collision_ms}.",

@@ -139,22 +139,15 @@ pub fn register(engine: &mut Engine) {
             let (nx, ny) = (count(&Dynamic::from_int(nx), "nx")?, count(&Dynamic::from_int(ny), "ny")?);
             Ok(ClothHandle(Shared::new(ClothModel::grid(w, h, nx, ny, f.0)?)))
         });
-    register!(engine, "cloth_cylinder", ["width: float", "height: float", "nx: int", "ny: int", "fabric: Fabric", "base: Array", "radius: float", "Cloth"],
-        "A `cloth_grid` wrapped around a vertical cylinder of `radius` whose bottom centre is `base`:
-the width runs around the axis (middle in front, at −y; the ends meet at the back, leaving a
-slit when the width is less than 2π·radius), the height upward. A tube or wrap skirt; the
-\"top\" edge is the upper rim.",
-        |w: Dynamic, h: Dynamic, nx: INT, ny: INT, f: Fabric, base: Dynamic, r: Dynamic| -> RResult<ClothHandle> {
-            let (w, h) = (num(&w, "width")?, num(&h, "height")?);
-            let (nx, ny) = (count(&Dynamic::from_int(nx), "nx")?, count(&Dynamic::from_int(ny), "ny")?);
-            let r = num(&r, "radius")?;
-            if !(r.is_finite() && r > 0.0) {
-                return Err(rt_err(format!("`radius` must be > 0, got {r}")));
-            }
+    register!(engine, "cloth_cone", ["r_top: float", "r_bottom: float", "height: float", "n_around: int", "n_down: int", "fabric: Fabric", "base: Array", "slit: float", "Cloth"],
+        "A truncated cone of cloth around the vertical axis through `base` (centre of its lower rim):\nradius `r_bottom` at the bottom, `r_top` at `height` above, cut from its exact flat pattern\n(an annular sector; equal radii give a cylinder). `n_around` × `n_down` particles; row i from\nthe bottom rim up, so the last `n_around` particles are the top rim. A slit of `slit` (a\nfraction of the circumference) is left open at the back (+y). An A-line skirt or a tube.",
+        |rt: Dynamic, rb: Dynamic, h: Dynamic, na: INT, nd: INT, f: Fabric, base: Dynamic, slit: Dynamic| -> RResult<ClothHandle> {
+            let (na, nd) = (count(&Dynamic::from_int(na), "n_around")?, count(&Dynamic::from_int(nd), "n_down")?);
             let base = crate::geometry::Vec3::from(super::convert::vec3(&base, "base")?);
-            let mut model = ClothModel::grid(w, h, nx, ny, f.0)?;
-            crate::geometry::grid::wrap_on_cylinder(&mut model.mesh.positions, base, r);
-            Ok(ClothHandle(Shared::new(model)))
+            let mesh = crate::geometry::cone::cone_mesh(
+                num(&rt, "r_top")?, num(&rb, "r_bottom")?, num(&h, "height")?, na, nd, base, num(&slit, "slit")?,
+            )?;
+            Ok(ClothHandle(Shared::new(ClothModel::from_mesh(mesh, f.0)?)))
         });
     register!(
         engine,
