@@ -79,22 +79,3 @@ fn check_no_self_intersection(model: ClothModel) {
     assert_eq!(exact, 0);
     assert_eq!(fast, 0);
 }
-
-#[test]
-#[ignore]
-fn probe_obj_intersections() {
-    let path = std::env::var("PROBE_OBJ").unwrap();
-    let m = emilion::geometry::read_obj(std::path::Path::new(&path)).unwrap();
-    let p: Vec<[f64; 3]> = m.positions.iter().map(|v| [v.x, v.y, v.z]).collect();
-    println!("exact {}", support::intersections::count_edge_triangle_intersections(&p, &m.triangles));
-    let mut k = 0;
-    for (a, b) in support::intersections::unique_edges(&m.triangles) {
-        for t in &m.triangles {
-            if t.contains(&a) || t.contains(&b) { continue; }
-            if support::intersections::segment_triangle_intersect_exact(p[a], p[b], p[t[0]], p[t[1]], p[t[2]]) {
-                if k < 6 { println!("edge {a}-{b} tri {t:?}"); }
-                k += 1;
-            }
-        }
-    }
-}

@@ -306,7 +306,9 @@ impl Collisions {
                 let (k, p, gap) = best?;
                 // a contact that pulled last step lets go unless the vertex is inside
                 let pulling = last[i] < 0.0 && p.distance >= 0.9 * h;
-                (gap < 1.1 * h && !pulling).then_some((k, p))
+                // only vertices already near the surface: one falling fast from further up (a top
+                // layer onto cloth resting on the body) is left to cloth–cloth contact and push-out
+                (gap < 1.1 * h && p.distance < 1.5 * h && !pulling).then_some((k, p))
             })
             .collect();
         let max_push = self.settings.max_push_speed;

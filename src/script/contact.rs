@@ -129,6 +129,21 @@ pub fn register(engine: &mut Engine) {
             let x = sim.state.x.clone();
             sim.contact.pin_to_body(index(b, "body")?, &p, &x, Some(snap)).map_err(contact_err)
         });
+    register!(engine, "save_body_obj", ["sim: Simulation", "body: int", "path: String"],
+        "Writes a body's current surface (a mesh body's triangles, or a tessellation of a sphere,\nbox or plane around the cloth) as an OBJ file.",
+        |h: &mut SimHandle, b: INT, path: &str| -> RResult<()> {
+            let sim = h.get()?;
+            let n = sim.contact.bodies.len();
+            let body = sim.contact.bodies.get(index(b, "body")?)
+                .ok_or_else(|| rt_err(format!("body {b} does not exist ({n} bodies)")))?;
+            let (lo, hi) = crate::geometry::mesh::bounds(&sim.state.x);
+            let (p, t) = crate::contact::tessellate::body_mesh(body, &lo, &hi);
+            if let Some(d) = Path::new(path).parent().filter(|d| !d.as_os_str().is_empty()) {
+                std::fs::create_dir_all(d).map_err(|e| rt_err(format!("{}: {e}", d.display())))?;
+            }
+            crate::geometry::write_obj(Path::new(path), &p, &t, None)?;
+            Ok(())
+        });
     register!(engine, "contact_report", ["sim: Simulation", "Map"],
         "Contact state now: #{bodies, min_distance (m, smallest signed vertex–body distance),\npenetrating (vertices inside bodies), intersections (intersecting cloth edge–triangle pairs)}\nand the last step's #{contacts, self_contacts, collision_ms}.",
         |h: &mut SimHandle| -> RResult<Map> {
