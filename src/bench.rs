@@ -103,7 +103,10 @@ pub fn bench_scene(
             let cm = s.iter().map(|x| x.collision_ms).sum::<f64>() / k;
             let x = sim.state.x.clone();
             let last = sim.contact.report(&x);
-            let md = s.iter().map(|x| x.min_distance).fold(f64::INFINITY, f64::min);
+            let md = s
+                .iter()
+                .map(|x| x.min_distance)
+                .fold(f64::INFINITY, f64::min);
             contact.push((
                 ms,
                 cm,

@@ -11,8 +11,8 @@ use crate::cloth::{
     ClothError, ClothModel, FabricParameters, Floor, Simulation, SimulationParameters,
 };
 use crate::contact::Body;
-use crate::geometry::Vec3;
 use crate::geometry::mesh::bounds;
+use crate::geometry::Vec3;
 use crate::geometry::{write_glb, write_obj};
 use crate::render::{render_png, Camera, RenderMesh};
 

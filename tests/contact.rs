@@ -50,8 +50,14 @@ fn cloth_on_incline_sticks_below_friction_angle_and_slides_above() {
     let theta = (angle + 2.0).to_radians();
     let expect = 0.5 * 9.81 * (theta.sin() - mu * theta.cos());
     println!("below: {below:.5} m, above: {above:.5} m (rigid-block answer {expect:.4} m)");
-    assert!(below.abs() < 2e-3, "slid {below} m below the friction angle");
-    assert!(above > 0.5 * expect, "slid only {above} m above the friction angle");
+    assert!(
+        below.abs() < 2e-3,
+        "slid {below} m below the friction angle"
+    );
+    assert!(
+        above > 0.5 * expect,
+        "slid only {above} m above the friction angle"
+    );
 }
 
 fn exact_intersections(x: &[Vec3], tris: &[[usize; 3]]) -> usize {
@@ -64,8 +70,9 @@ fn exact_intersections(x: &[Vec3], tris: &[[usize; 3]]) -> usize {
 #[test]
 fn cylinder_and_cone_cloths_do_not_intersect_themselves() {
     for (rt, rb) in [(0.22, 0.22), (0.16, 0.26)] {
-        let mesh = emilion::geometry::cone::cone_mesh(rt, rb, 0.5, 64, 20, Vec3::new(0.0, 0.0, 0.5), 0.05)
-            .unwrap();
+        let mesh =
+            emilion::geometry::cone::cone_mesh(rt, rb, 0.5, 64, 20, Vec3::new(0.0, 0.0, 0.5), 0.05)
+                .unwrap();
         let model = ClothModel::from_mesh(mesh, FabricParameters::default()).unwrap();
         check_no_self_intersection(model);
     }
@@ -78,4 +85,165 @@ fn check_no_self_intersection(model: ClothModel) {
     let fast = sim.contact.report(&x).intersections;
     assert_eq!(exact, 0);
     assert_eq!(fast, 0);
+}
+
+#[test]
+fn bad_body_meshes_are_rejected_or_repaired_with_clear_errors() {
+    let p = |x: f64, y: f64, z: f64| Vec3::new(x, y, z);
+    let quad = vec![
+        p(0., 0., 0.),
+        p(1., 0., 0.),
+        p(1., 1., 0.),
+        p(0., 1., 0.),
+        p(0.5, 0.5, 1.0),
+    ];
+    // a degenerate (repeated index) and a zero-area triangle are dropped
+    let m = MeshBody::new(
+        "m",
+        quad.clone(),
+        &[[0, 1, 2], [0, 2, 3], [1, 1, 2], [0, 1, 1]],
+    )
+    .unwrap();
+    assert_eq!(m.dropped_degenerate, 2);
+    let collinear = vec![p(0., 0., 0.), p(1., 0., 0.), p(2., 0., 0.), p(0., 1., 0.)];
+    let m = MeshBody::new("m", collinear, &[[0, 1, 2], [0, 1, 3]]).unwrap();
+    assert_eq!(m.dropped_degenerate, 1);
+    // three triangles on one edge: non-manifold, named
+    let e = MeshBody::new("fan", quad.clone(), &[[0, 1, 2], [1, 0, 3], [0, 1, 4]]).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        msg.contains("fan") && msg.contains("non-manifold edge (0, 1)"),
+        "{msg}"
+    );
+    // two neighbours wound the same way along their shared edge
+    let e = MeshBody::new("flip", quad.clone(), &[[0, 1, 2], [0, 3, 2]]).unwrap_err();
+    assert!(e.to_string().contains("inconsistent winding"), "{e}");
+    // out-of-range index, NaN vertex, nothing left
+    let e = MeshBody::new("m", quad.clone(), &[[0, 1, 9]]).unwrap_err();
+    assert!(e.to_string().contains("vertex 9"), "{e}");
+    let mut nan = quad.clone();
+    nan[2].y = f64::NAN;
+    assert!(MeshBody::new("m", nan, &[[0, 1, 2]])
+        .unwrap_err()
+        .to_string()
+        .contains("vertex 2 is not finite"));
+    assert!(MeshBody::new("m", quad, &[[1, 1, 2]])
+        .unwrap_err()
+        .to_string()
+        .contains("no triangle"));
+}
+
+/// A closed UV-sphere mesh of radius `r`, outward or (with `inward`) inward wound.
+fn sphere_mesh(r: f64, inward: bool) -> (Vec<Vec3>, Vec<[usize; 3]>) {
+    let (nu, nv) = (48, 24);
+    let mut p = vec![Vec3::new(0.0, 0.0, r)];
+    for j in 1..nv {
+        let th = std::f64::consts::PI * j as f64 / nv as f64;
+        for i in 0..nu {
+            let ph = 2.0 * std::f64::consts::PI * i as f64 / nu as f64;
+            p.push(Vec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()) * r);
+        }
+    }
+    p.push(Vec3::new(0.0, 0.0, -r));
+    let last = p.len() - 1;
+    let ring = |j: usize, i: usize| 1 + (j - 1) * nu + i % nu;
+    let mut t = Vec::new();
+    for i in 0..nu {
+        t.push([0, ring(1, i), ring(1, i + 1)]);
+        t.push([last, ring(nv - 1, i + 1), ring(nv - 1, i)]);
+        for j in 1..nv - 1 {
+            t.push([ring(j, i), ring(j + 1, i), ring(j + 1, i + 1)]);
+            t.push([ring(j, i), ring(j + 1, i + 1), ring(j, i + 1)]);
+        }
+    }
+    if inward {
+        t.iter_mut().for_each(|x| x.swap(1, 2));
+    }
+    (p, t)
+}
+
+#[test]
+fn body_signed_distances_match_analytic_answers() {
+    let sphere = Body::sphere(Vec3::new(0.1, 0.0, 0.0), 0.3).unwrap();
+    assert!((sphere.signed_distance(&Vec3::new(0.1, 0.0, 0.5)) - 0.2).abs() < 1e-15);
+    assert!((sphere.signed_distance(&Vec3::new(0.2, 0.0, 0.0)) + 0.2).abs() < 1e-15);
+    let cube = Body::cuboid(Vec3::zeros(), Vec3::new(0.8, 0.8, 0.75)).unwrap();
+    assert!((cube.signed_distance(&Vec3::new(0.0, 0.0, 0.5)) - 0.125).abs() < 1e-15);
+    // beyond a corner: the distance to the corner
+    let d = cube.signed_distance(&Vec3::new(0.5, 0.5, 0.375));
+    assert!((d - (0.02f64).sqrt()).abs() < 1e-15);
+    assert!((cube.signed_distance(&Vec3::new(0.0, 0.3, 0.0)) + 0.1).abs() < 1e-15);
+    let plane = Body::plane(Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.0, 0.0, 2.0)).unwrap();
+    assert!((plane.signed_distance(&Vec3::new(5.0, 3.0, 0.5)) + 0.5).abs() < 1e-15);
+    assert!(Body::sphere(Vec3::zeros(), -1.0).is_err());
+    assert!(Body::plane(Vec3::zeros(), Vec3::zeros()).is_err());
+
+    // a tessellated sphere (either winding) against the analytic one: inside where it should
+    // be, distances within the tessellation's sagitta
+    for inward in [false, true] {
+        let (p, t) = sphere_mesh(0.3, inward);
+        let mesh = Body::mesh(MeshBody::new("ball", p, &t).unwrap());
+        let sag = 0.3 * (1.0 - (std::f64::consts::PI / 24.0).cos());
+        let mut seed = 12345u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        for _ in 0..2000 {
+            let q = Vec3::new(rnd(), rnd(), rnd()) * 0.45;
+            let exact = q.norm() - 0.3;
+            let got = mesh.signed_distance(&q);
+            assert!(
+                (got - exact).abs() <= sag + 1e-9,
+                "at {q:?}: {got} vs {exact} (inward {inward})"
+            );
+            if exact.abs() > sag {
+                assert_eq!(got < 0.0, exact < 0.0, "inside test wrong at {q:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn spatial_hash_finds_exactly_the_overlapping_boxes() {
+    use emilion::contact::spatial_hash::{Aabb, SpatialHash};
+    let mut seed = 7u64;
+    let mut rnd = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let boxes: Vec<Aabb> = (0..3000)
+        .map(|k| {
+            let c = Vec3::new(rnd(), rnd(), rnd() * 0.2);
+            // mostly small boxes, a few large ones (scanned separately)
+            let s = if k % 500 == 0 {
+                0.3
+            } else {
+                0.01 + 0.02 * rnd()
+            };
+            Aabb {
+                min: c,
+                max: c + Vec3::new(s, s * rnd(), s * 0.5),
+            }
+        })
+        .collect();
+    let mut hash = SpatialHash::default();
+    hash.build(&boxes, 0.03);
+    let mut out = Vec::new();
+    for q in boxes.iter().step_by(7) {
+        hash.query(q, &mut out);
+        let mut got = out.clone();
+        got.sort_unstable();
+        let n = got.len();
+        got.dedup();
+        assert_eq!(n, got.len(), "duplicates in a query");
+        let want: Vec<u32> = (0..boxes.len() as u32)
+            .filter(|&i| boxes[i as usize].overlaps(q))
+            .collect();
+        assert_eq!(got, want);
+    }
 }

@@ -20,7 +20,8 @@ fn read_plain_obj(path: &Path) -> TriMesh {
         match it.next() {
             Some("v") => {
                 let c: Vec<f64> = it.take(3).map(|s| s.parse().unwrap()).collect();
-                m.positions.push(emilion::geometry::Vec3::new(c[0], c[1], c[2]));
+                m.positions
+                    .push(emilion::geometry::Vec3::new(c[0], c[1], c[2]));
             }
             Some("f") => {
                 let c: Vec<usize> = it
@@ -42,7 +43,9 @@ fn root() -> PathBuf {
 
 /// Runs `scripts/NAME.rhai` into a fresh folder with extra `sets`; returns the folder.
 fn run(name: &str, sets: &[(&str, &str)]) -> PathBuf {
-    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("contact").join(name);
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("contact")
+        .join(name);
     let _ = std::fs::remove_dir_all(&out);
     std::fs::create_dir_all(&out).unwrap();
     let mut all = vec![("out".to_string(), out.display().to_string())];
@@ -70,7 +73,10 @@ fn frames(dir: &Path) -> usize {
 
 fn no_self_intersection(m: &TriMesh, what: &str) {
     let k = count_edge_triangle_intersections(&points(m), &m.triangles);
-    assert_eq!(k, 0, "{what}: {k} intersecting cloth (edge, triangle) pairs");
+    assert_eq!(
+        k, 0,
+        "{what}: {k} intersecting cloth (edge, triangle) pairs"
+    );
 }
 
 #[test]
@@ -78,11 +84,22 @@ fn drape_sphere_no_penetration_no_intersection() {
     let dir = run("drape_sphere", &[]);
     assert_eq!(frames(&dir), 10);
     let cloth = read_obj(&dir.join("drape_sphere.obj")).unwrap();
-    let worst = cloth.positions.iter().map(|p| p.norm() - 0.3).fold(f64::INFINITY, f64::min);
+    let worst = cloth
+        .positions
+        .iter()
+        .map(|p| p.norm() - 0.3)
+        .fold(f64::INFINITY, f64::min);
     assert!(worst >= 0.0, "a vertex is {} m inside the sphere", -worst);
     // it draped: the cloth hangs below the sphere's equator
-    let lowest = cloth.positions.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
-    assert!(lowest < -0.05, "cloth lowest point {lowest} m: it did not drape");
+    let lowest = cloth
+        .positions
+        .iter()
+        .map(|p| p.z)
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        lowest < -0.05,
+        "cloth lowest point {lowest} m: it did not drape"
+    );
     no_self_intersection(&cloth, "drape_sphere");
 }
 
@@ -93,11 +110,21 @@ fn drape_table_no_penetration_no_intersection() {
     let cloth = read_obj(&dir.join("drape_table.obj")).unwrap();
     for p in &cloth.positions {
         let inside_table = p.x.abs() < 0.4 && p.y.abs() < 0.4 && p.z > 0.0 && p.z < 0.75;
-        assert!(!inside_table && p.z >= 0.0, "vertex inside the table or floor at {p:?}");
+        assert!(
+            !inside_table && p.z >= 0.0,
+            "vertex inside the table or floor at {p:?}"
+        );
     }
     // the corners hang below the table top: folds over the corners
-    let lowest = cloth.positions.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
-    assert!(lowest < 0.6, "lowest point {lowest} m: the cloth did not fall over the edges");
+    let lowest = cloth
+        .positions
+        .iter()
+        .map(|p| p.z)
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        lowest < 0.6,
+        "lowest point {lowest} m: the cloth did not fall over the edges"
+    );
     no_self_intersection(&cloth, "drape_table");
 }
 
@@ -106,7 +133,10 @@ fn self_fold_lands_on_itself_without_intersection() {
     let dir = run("self_fold", &[]);
     assert_eq!(frames(&dir), 12);
     let cloth = read_obj(&dir.join("self_fold.obj")).unwrap();
-    assert!(cloth.positions.iter().all(|p| p.z >= 0.0), "a vertex is under the floor");
+    assert!(
+        cloth.positions.iter().all(|p| p.z >= 0.0),
+        "a vertex is under the floor"
+    );
     // folded: the cloth now covers about half its width, in two layers
     let (lo, hi) = emilion::geometry::mesh::bounds(&cloth.positions);
     assert!(hi.x - lo.x < 0.45, "x span {}: not folded", hi.x - lo.x);
@@ -139,8 +169,16 @@ fn mannequin_walk_two_seconds_without_penetration() {
         .filter(|(_, p)| inside_mesh([p.x, p.y, p.z], &body, &pts))
         .map(|(i, _)| i)
         .collect();
-    assert!(inside.is_empty(), "skirt vertices inside the mannequin: {inside:?}");
+    assert!(
+        inside.is_empty(),
+        "skirt vertices inside the mannequin: {inside:?}"
+    );
     // the skirt is worn: it stays around the hips, hem below them
     let (lo, hi) = emilion::geometry::mesh::bounds(&skirt.positions);
-    assert!(hi.z > 0.95 && lo.z < 0.7, "skirt spans z {}..{}", lo.z, hi.z);
+    assert!(
+        hi.z > 0.95 && lo.z < 0.7,
+        "skirt spans z {}..{}",
+        lo.z,
+        hi.z
+    );
 }

@@ -640,6 +640,7 @@ fn travel_is_kept_without_in_place() {
     let options = RetargetOptions {
         in_place: false,
         start_time: 0.5,
+        ..Default::default()
     };
     let a = Animation::new(mannequin().clone(), clip("002_01.bvh"), options).unwrap();
     assert!((a.duration() - 2.35).abs() < 1e-3);

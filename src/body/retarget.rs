@@ -515,8 +515,8 @@ fn pose_for_frame(
                 spread,
             } => {
                 let lateral = r * Vec3::x() * spread;
-                if let Some(e) = (p[to] - p[from] + lateral * (p[to] - p[from]).norm())
-                    .try_normalize(1e-12)
+                if let Some(e) =
+                    (p[to] - p[from] + lateral * (p[to] - p[from]).norm()).try_normalize(1e-12)
                 {
                     r = swing(r * dir, e) * r;
                 }

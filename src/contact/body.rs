@@ -107,7 +107,7 @@ pub struct Body {
 impl Body {
     /// A solid sphere.
     pub fn sphere(center: Vec3, radius: f64) -> Result<Body, ContactError> {
-        if !(radius.is_finite() && radius > 0.0) || !finite(&center) {
+        if !(radius.is_finite() && radius > 0.0 && finite(&center)) {
             return Err(ContactError::Parameter(format!(
                 "sphere: radius must be > 0 and the centre finite, got radius {radius}, centre {:?}",
                 center.as_slice()
@@ -137,7 +137,7 @@ impl Body {
     /// The solid half-space below the plane through `point` with outward `normal`.
     pub fn plane(point: Vec3, normal: Vec3) -> Result<Body, ContactError> {
         let n = normal.norm();
-        if !finite(&point) || !(n.is_finite() && n > 1e-12) {
+        if !(finite(&point) && n.is_finite() && n > 1e-12) {
             return Err(ContactError::Parameter(format!(
                 "plane: the point must be finite and the normal finite and non-zero, got point {:?}, normal {:?}",
                 point.as_slice(),

@@ -197,7 +197,8 @@ impl Collisions {
         snap: Option<(f64, f64, f64)>,
     ) -> Result<(), ContactError> {
         if let Some((gap, from, to)) = snap {
-            if !(gap.is_finite() && gap >= 0.0 && from.is_finite() && to.is_finite() && to >= from) {
+            if !(gap.is_finite() && gap >= 0.0 && from.is_finite() && to.is_finite() && to >= from)
+            {
                 return Err(ContactError::Parameter(format!(
                     "pin_to_body: snap needs gap >= 0 and from <= to, got gap {gap}, from {from}, to {to}"
                 )));
@@ -265,8 +266,11 @@ impl Collisions {
         }
         for pin in &self.pins {
             if let Some(Shape::Mesh(m)) = self.bodies.get(pin.body).map(|b| &b.shape) {
-                let target =
-                    pin.target(&m.positions()[pin.vertex], &m.vertex_normal(pin.vertex), t + dt);
+                let target = pin.target(
+                    &m.positions()[pin.vertex],
+                    &m.vertex_normal(pin.vertex),
+                    t + dt,
+                );
                 filter.kind[pin.particle] = ParticleFilter::Fixed { target };
                 filter.any = true;
             }
@@ -376,7 +380,10 @@ impl Collisions {
                 self.stuck[i] = false;
                 continue;
             }
-            let mu = self.settings.friction.combine(&self.bodies[s.body as usize].friction);
+            let mu = self
+                .settings
+                .friction
+                .combine(&self.bodies[s.body as usize].friction);
             if s.stuck {
                 let jt = (impulse[i] - s.normal * jn).norm();
                 self.stuck[i] = jt <= mu.static_ * jn;
@@ -522,10 +529,9 @@ impl Collisions {
                 // the signed distance, negated, for the reduction below
                 *di = if m.is_finite() { -m } else { f64::NEG_INFINITY };
             });
-        let (min, inside) = self
-            .depth
-            .iter()
-            .fold((f64::INFINITY, 0), |(m, k), &d| (m.min(-d), k + usize::from(d > 0.0)));
+        let (min, inside) = self.depth.iter().fold((f64::INFINITY, 0), |(m, k), &d| {
+            (m.min(-d), k + usize::from(d > 0.0))
+        });
         for d in &mut self.depth {
             *d = d.max(0.0);
         }

@@ -58,7 +58,10 @@ impl MeshBody {
             body: name.to_string(),
             message,
         };
-        if let Some(i) = positions.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+        if let Some(i) = positions
+            .iter()
+            .position(|p| !p.iter().all(|c| c.is_finite()))
+        {
             return Err(err(format!("vertex {i} is not finite")));
         }
         let n = positions.len();
@@ -74,7 +77,11 @@ impl MeshBody {
             }
             let [a, b, c] = tri.map(|i| positions[i]);
             let area2 = (b - a).cross(&(c - a)).norm();
-            if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] || area2 <= 1e-14 * scale * scale {
+            if tri[0] == tri[1]
+                || tri[1] == tri[2]
+                || tri[0] == tri[2]
+                || area2 <= 1e-14 * scale * scale
+            {
                 dropped += 1;
                 continue;
             }
@@ -84,7 +91,8 @@ impl MeshBody {
             return Err(err("no triangle with a non-zero area".into()));
         }
         // edge → (triangle, local edge) of its first use, checking manifoldness and winding
-        let mut first: HashMap<(usize, usize), (u32, u8, bool)> = HashMap::with_capacity(tris.len() * 2);
+        let mut first: HashMap<(usize, usize), (u32, u8, bool)> =
+            HashMap::with_capacity(tris.len() * 2);
         let mut across = vec![[NONE; 3]; tris.len()];
         for (t, tri) in tris.iter().enumerate() {
             for k in 0..3 {

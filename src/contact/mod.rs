@@ -5,8 +5,8 @@
 //! exact geometric primitives they rest on.
 
 pub mod body;
-pub mod character;
 pub mod ccd;
+pub mod character;
 pub mod collisions;
 pub mod error;
 pub mod mesh_body;

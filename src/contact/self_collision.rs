@@ -15,7 +15,9 @@ use nalgebra::Rotation3;
 use rayon::prelude::*;
 
 use super::ccd::{edge_edge_ccd, vertex_face_ccd, CcdHit};
-use super::primitives::{closest_point_triangle, closest_points_segments, segment_triangle_intersect};
+use super::primitives::{
+    closest_point_triangle, closest_points_segments, segment_triangle_intersect,
+};
 use super::spatial_hash::{Aabb, SpatialHash};
 use crate::geometry::{Mat3, Vec3};
 
@@ -134,9 +136,11 @@ impl SelfCollision {
             b.inflated(pad)
         };
         self.tri_boxes.clear();
-        self.tri_boxes.extend(self.triangles.iter().map(|t| swept(t, pad)));
+        self.tri_boxes
+            .extend(self.triangles.iter().map(|t| swept(t, pad)));
         self.edge_boxes.clear();
-        self.edge_boxes.extend(self.edges.iter().map(|e| swept(e, 0.5 * pad)));
+        self.edge_boxes
+            .extend(self.edges.iter().map(|e| swept(e, 0.5 * pad)));
         self.tri_hash.build(&self.tri_boxes, self.cell);
         self.edge_hash.build(&self.edge_boxes, self.cell);
         let (tris, edges) = (&self.triangles, &self.edges);
@@ -153,7 +157,11 @@ impl SelfCollision {
                     b.grow(&(x0[i] + d[i]));
                     tri_hash.query(&b, &mut buf);
                     let iu = i as u32;
-                    out.extend(buf.iter().filter(|&&t| !tris[t as usize].contains(&iu)).map(|&t| (iu, t)));
+                    out.extend(
+                        buf.iter()
+                            .filter(|&&t| !tris[t as usize].contains(&iu))
+                            .map(|&t| (iu, t)),
+                    );
                 }
                 out
             })
@@ -220,7 +228,14 @@ impl SelfCollision {
     /// vertex in proportion to its weight and inverse mass. When the free vertices carry little
     /// weight (the pair's other vertices are held), no vertex moves more than twice `change`:
     /// the pair is then left to the impact zones rather than flung apart.
-    fn impulse(d: &mut [Vec3], inv_mass: &[f64], vs: &[usize; 4], w: &[f64; 4], dir: &Vec3, change: f64) {
+    fn impulse(
+        d: &mut [Vec3],
+        inv_mass: &[f64],
+        vs: &[usize; 4],
+        w: &[f64; 4],
+        dir: &Vec3,
+        change: f64,
+    ) {
         let den: f64 = (0..4).map(|k| w[k] * w[k] * inv_mass[vs[k]]).sum();
         if den <= 0.0 {
             return;
@@ -317,9 +332,18 @@ impl SelfCollision {
             rep.ccd_hits += hits.len();
             for (k, hit) in &hits {
                 let vs = self.pair_vertices(*k);
-                let s0: f64 = (0..4).map(|m| hit.weights[m] * x0[vs[m]].dot(&hit.normal)).sum();
+                let s0: f64 = (0..4)
+                    .map(|m| hit.weights[m] * x0[vs[m]].dot(&hit.normal))
+                    .sum();
                 let target = SEPARATION * thickness - s0;
-                Self::push_apart(&mut self.d, inv_mass, &vs, &hit.weights, &hit.normal, target);
+                Self::push_apart(
+                    &mut self.d,
+                    inv_mass,
+                    &vs,
+                    &hit.weights,
+                    &hit.normal,
+                    target,
+                );
             }
         }
 
@@ -490,7 +514,11 @@ impl SelfCollision {
     }
 
     fn rigid_motion(&mut self, zone: &[usize], x0: &[Vec3], inv_mass: &[f64]) {
-        let pinned: Vec<usize> = zone.iter().copied().filter(|&i| inv_mass[i] == 0.0).collect();
+        let pinned: Vec<usize> = zone
+            .iter()
+            .copied()
+            .filter(|&i| inv_mass[i] == 0.0)
+            .collect();
         if !pinned.is_empty() {
             // a zone holding prescribed vertices follows their mean displacement
             let mean = pinned.iter().map(|&i| self.d[i]).sum::<Vec3>() / pinned.len() as f64;
@@ -540,7 +568,8 @@ impl SelfCollision {
             b
         };
         self.tri_boxes.clear();
-        self.tri_boxes.extend(self.triangles.iter().map(|t| tight(t)));
+        self.tri_boxes
+            .extend(self.triangles.iter().map(|t| tight(t)));
         self.tri_hash.build(&self.tri_boxes, self.cell);
         let (tris, edges, hash) = (&self.triangles, &self.edges, &self.tri_hash);
         let ne = edges.len();
@@ -559,7 +588,13 @@ impl SelfCollision {
                             continue;
                         }
                         let p = t.map(|i| x[i as usize]);
-                        if segment_triangle_intersect(x[a as usize], x[b as usize], p[0], p[1], p[2]) {
+                        if segment_triangle_intersect(
+                            x[a as usize],
+                            x[b as usize],
+                            p[0],
+                            p[1],
+                            p[2],
+                        ) {
                             count += 1;
                         }
                     }

@@ -149,10 +149,25 @@ impl SpatialHash {
             min: b.min - self.margin,
             max: b.max + self.margin,
         };
-        let (i0, j0, k0) = (cell_of(wide.min.x, cell), cell_of(wide.min.y, cell), cell_of(wide.min.z, cell));
-        let (i1, j1, k1) = (cell_of(wide.max.x, cell), cell_of(wide.max.y, cell), cell_of(wide.max.z, cell));
-        let span = |a: i64, z: i64| z.checked_sub(a).is_none_or(|d| !(0..=MAX_SPAN).contains(&d));
-        let finite = wide.min.iter().chain(wide.max.iter()).all(|c| c.is_finite());
+        let (i0, j0, k0) = (
+            cell_of(wide.min.x, cell),
+            cell_of(wide.min.y, cell),
+            cell_of(wide.min.z, cell),
+        );
+        let (i1, j1, k1) = (
+            cell_of(wide.max.x, cell),
+            cell_of(wide.max.y, cell),
+            cell_of(wide.max.z, cell),
+        );
+        let span = |a: i64, z: i64| {
+            z.checked_sub(a)
+                .is_none_or(|d| !(0..=MAX_SPAN).contains(&d))
+        };
+        let finite = wide
+            .min
+            .iter()
+            .chain(wide.max.iter())
+            .all(|c| c.is_finite());
         if !finite || span(i0, i1) || span(j0, j1) || span(k0, k1) {
             // a huge query box: scan everything
             for (id, bx) in self.boxes.iter().enumerate() {
@@ -168,7 +183,9 @@ impl SpatialHash {
                     let h = cell_hash(i, j, k) & self.mask;
                     for &id in &self.entries[self.starts[h] as usize..self.starts[h + 1] as usize] {
                         // the home check drops other cells hashed to the same bucket
-                        if self.home[id as usize] == (i, j, k) && self.boxes[id as usize].overlaps(b) {
+                        if self.home[id as usize] == (i, j, k)
+                            && self.boxes[id as usize].overlaps(b)
+                        {
                             out.push(id);
                         }
                     }

@@ -62,7 +62,11 @@ fn plane(point: &Vec3, n: &Vec3, lo: &Vec3, hi: &Vec3) -> (Vec<Vec3>, Vec<[usize
     let size = (hi - lo).norm().clamp(0.5, 1e3) * 1.5;
     let centre = (lo + hi) * 0.5;
     let c = centre - n * (centre - point).dot(n);
-    let helper = if n.z.abs() < 0.9 { Vec3::z() } else { Vec3::x() };
+    let helper = if n.z.abs() < 0.9 {
+        Vec3::z()
+    } else {
+        Vec3::x()
+    };
     let u = n.cross(&helper).normalize() * size;
     let v = n.cross(&u);
     let p = vec![c - u - v, c + u - v, c + u + v, c - u + v];

@@ -47,4 +47,3 @@ pub fn grid_mesh(width: f64, height: f64, nx: usize, ny: usize) -> Result<TriMes
         triangles,
     })
 }
-

@@ -14,7 +14,7 @@ pub use error::GeometryError;
 pub use gltf::write_glb;
 pub use grid::grid_mesh;
 pub use mesh::TriMesh;
-pub use obj::{read_obj, write_obj};
+pub use obj::{read_obj, read_obj_surface, write_obj};
 pub use topology::{Edge, Hinge, Topology};
 
 /// Three-vector of f64, SI units (metres, m/s, newtons).

@@ -105,7 +105,7 @@ pub fn read_obj(path: &Path) -> Result<TriMesh, GeometryError> {
         path: path.to_path_buf(),
         source,
     })?;
-    let (mesh, face_lines) = parse(&text).map_err(|(line, message)| err(line, message))?;
+    let (mesh, face_lines) = parse(&text, true).map_err(|(line, message)| err(line, message))?;
     if mesh.triangles.is_empty() {
         return Err(err(
             0,
@@ -127,12 +127,33 @@ pub fn read_obj(path: &Path) -> Result<TriMesh, GeometryError> {
     Ok(mesh)
 }
 
+/// Reads the surface of an OBJ file (a collision body): vertex positions and triangles, polygons
+/// fanned; texture coordinates and normals are ignored. Errors as [`read_obj`] (file and line);
+/// the mesh's own validity (degenerate or non-manifold faces) is left to its user.
+pub fn read_obj_surface(path: &Path) -> Result<(Vec<Vec3>, Vec<[usize; 3]>), GeometryError> {
+    let err = |line: usize, message: String| GeometryError::Parse {
+        path: path.to_path_buf(),
+        line,
+        message,
+    };
+    let text = fs::read_to_string(path).map_err(|source| GeometryError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let (mesh, _) = parse(&text, false).map_err(|(line, message)| err(line, message))?;
+    if mesh.triangles.is_empty() {
+        return Err(err(0, "no faces (`f` lines)".into()));
+    }
+    Ok((mesh.positions, mesh.triangles))
+}
+
 /// Why texture coordinates are required.
 const NEEDS_UV: &str = "a cloth mesh needs texture coordinates (vt) as rest coordinates in metres";
 
 /// Parses OBJ text into a mesh and, per triangle, the 1-based line of its face. Errors carry
-/// the 1-based line and a message.
-fn parse(text: &str) -> Result<(TriMesh, Vec<usize>), (usize, String)> {
+/// the 1-based line and a message. Without `need_uv`, texture coordinates are ignored (every
+/// corner takes a zero rest coordinate, so vertices are never split at UV seams).
+fn parse(text: &str, need_uv: bool) -> Result<(TriMesh, Vec<usize>), (usize, String)> {
     let mut total = [0usize; 3];
     for line in text.lines() {
         match line.split_whitespace().next() {
@@ -159,7 +180,7 @@ fn parse(text: &str) -> Result<(TriMesh, Vec<usize>), (usize, String)> {
             Some("f") => {
                 let seen = [positions.len(), uvs.len(), normals];
                 let face = words
-                    .map(|c| corner(c, &seen, &total))
+                    .map(|c| corner(c, &seen, &total, need_uv))
                     .collect::<Result<Vec<_>, _>>();
                 let face = face.map_err(|m| (ln, m))?;
                 if face.len() < 3 {
@@ -201,7 +222,10 @@ fn parse(text: &str) -> Result<(TriMesh, Vec<usize>), (usize, String)> {
     keys.dedup();
     let mesh = TriMesh {
         positions: keys.iter().map(|k| positions[k[0]]).collect(),
-        rest: keys.iter().map(|k| uvs[k[1]]).collect(),
+        rest: keys
+            .iter()
+            .map(|k| if need_uv { uvs[k[1]] } else { [0.0, 0.0] })
+            .collect(),
         triangles: corners
             .chunks_exact(3)
             .map(|c| [0, 1, 2].map(|j| keys.binary_search(&c[j]).unwrap_or_default()))
@@ -213,7 +237,12 @@ fn parse(text: &str) -> Result<(TriMesh, Vec<usize>), (usize, String)> {
 /// Resolves one face corner `v/vt[/vn]` to 0-based (position, texture coordinate) indices,
 /// checking it against the elements seen so far (negative, relative indices) and in the
 /// whole file (positive indices).
-fn corner(corner: &str, seen: &[usize; 3], total: &[usize; 3]) -> Result<[usize; 2], String> {
+fn corner(
+    corner: &str,
+    seen: &[usize; 3],
+    total: &[usize; 3],
+    need_uv: bool,
+) -> Result<[usize; 2], String> {
     const NAMES: [&str; 3] = ["vertex", "texture coordinate", "normal"];
     let parts: Vec<&str> = corner.split('/').collect();
     if parts.len() > 3 {
@@ -245,6 +274,9 @@ fn corner(corner: &str, seen: &[usize; 3], total: &[usize; 3]) -> Result<[usize;
             ));
         };
         resolved[k] = index;
+    }
+    if !need_uv {
+        return Ok([resolved[0], 0]);
     }
     if resolved[1] == usize::MAX {
         return Err(format!(

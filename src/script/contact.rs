@@ -12,7 +12,7 @@ use crate::body::RetargetOptions;
 use crate::cloth::ClothError;
 use crate::contact::character::mannequin_body;
 use crate::contact::{Body, ContactError, ContactSettings, FrictionCoefficients, MeshBody};
-use crate::geometry::{read_obj, Vec3};
+use crate::geometry::{read_obj_surface, Vec3};
 
 fn contact_err(e: ContactError) -> Box<rhai::EvalAltResult> {
     ClothError::Contact(e).into()
@@ -36,11 +36,15 @@ fn data_dir() -> std::path::PathBuf {
 
 /// Registers the contact functions of `Simulation`.
 pub fn register(engine: &mut Engine) {
-    register!(engine, "add_sphere", ["sim: Simulation", "center: Array", "radius: float", "int"],
+    register!(
+        engine,
+        "add_sphere",
+        ["sim: Simulation", "center: Array", "radius: float", "int"],
         "Adds a static solid sphere; returns its body index.",
         |h: &mut SimHandle, c: Dynamic, r: Dynamic| -> RResult<INT> {
             add_body(h, Body::sphere(v3(&c, "center")?, finite(&r, "radius")?))
-        });
+        }
+    );
     register!(engine, "add_box", ["sim: Simulation", "center: Array", "size: Array", "int"],
         "Adds a static solid axis-aligned box of full size `[sx, sy, sz]` m; returns its body index.",
         |h: &mut SimHandle, c: Dynamic, s: Dynamic| -> RResult<INT> {
@@ -54,8 +58,8 @@ pub fn register(engine: &mut Engine) {
     register!(engine, "add_obstacle", ["sim: Simulation", "path: String", "int"],
         "Adds a static triangle mesh read from an OBJ file (metres) as a body. Degenerate triangles\nare dropped; a non-manifold or inconsistently wound mesh is an error naming the edge.\nReturns its body index.",
         |h: &mut SimHandle, path: &str| -> RResult<INT> {
-            let mesh = read_obj(Path::new(path))?;
-            add_body(h, MeshBody::new(path, mesh.positions, &mesh.triangles).map(Body::mesh))
+            let (positions, triangles) = read_obj_surface(Path::new(path))?;
+            add_body(h, MeshBody::new(path, positions, &triangles).map(Body::mesh))
         });
     register!(engine, "add_mannequin", ["sim: Simulation", "options: Map", "int"],
         "Adds the MakeHuman mannequin (feet on z = 0, facing −y) as a body, animated by a BVH clip:\n`#{motion: \"path.bvh\", in_place: true, start: 0.0, blend: 0.0, makehuman: \"dir\"}`. Without\n`motion` it stands still in its rest pose. With `blend` > 0 it moves from its rest pose into the\nclip's first frame over `blend` seconds before the clip plays (dress it at rest, then move);
@@ -104,9 +108,13 @@ pub fn register(engine: &mut Engine) {
             sim.contact.settings = s;
             Ok(())
         });
-    register!(engine, "contact_settings", ["sim: Simulation", "Map"],
+    register!(
+        engine,
+        "contact_settings",
+        ["sim: Simulation", "Map"],
         "The contact settings as a map (see `set_contact`).",
-        |h: &mut SimHandle| -> RResult<Dynamic> { Ok(to_map(&h.get()?.contact.settings)) });
+        |h: &mut SimHandle| -> RResult<Dynamic> { Ok(to_map(&h.get()?.contact.settings)) }
+    );
     register!(engine, "pin_to_body", ["sim: Simulation", "particles: Array", "body: int"],
         "Makes particles follow a mesh body (e.g. a waistband on the mannequin): each keeps its\npresent offset from the body vertex nearest to it (in the body's rest pose), turning with it.",
         |h: &mut SimHandle, p: Array, b: INT| -> RResult<()> {

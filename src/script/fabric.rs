@@ -159,15 +159,22 @@ pub fn register(engine: &mut Engine) {
             Ok(ClothHandle(Shared::new(ClothModel::from_mesh(mesh, f.0)?)))
         }
     );
-    register!(engine, "translated", ["cloth: Cloth", "offset: Array", "Cloth"],
+    register!(
+        engine,
+        "translated",
+        ["cloth: Cloth", "offset: Array", "Cloth"],
         "A copy of the cloth moved by `offset` [dx, dy, dz] m (its pattern is unchanged).",
         |c: &mut ClothHandle, d: Dynamic| -> RResult<ClothHandle> {
             let d = crate::geometry::Vec3::from(super::convert::vec3(&d, "offset")?);
             let mut m = (*c.0).clone();
             m.mesh.positions.iter_mut().for_each(|p| *p += d);
             Ok(ClothHandle(Shared::new(m)))
-        });
-    register!(engine, "rotated", ["cloth: Cloth", "axis: Array", "degrees: float", "Cloth"],
+        }
+    );
+    register!(
+        engine,
+        "rotated",
+        ["cloth: Cloth", "axis: Array", "degrees: float", "Cloth"],
         "A copy of the cloth turned by `degrees` about `axis` [x, y, z] through the origin
 (right-hand rule; its pattern is unchanged).",
         |c: &mut ClothHandle, axis: Dynamic, deg: Dynamic| -> RResult<ClothHandle> {
@@ -180,7 +187,8 @@ pub fn register(engine: &mut Engine) {
             let mut m = (*c.0).clone();
             m.mesh.positions.iter_mut().for_each(|p| *p = r * *p);
             Ok(ClothHandle(Shared::new(m)))
-        });
+        }
+    );
     getter!(
         engine,
         "vertex_count",
