@@ -61,20 +61,7 @@ pub fn cone_mesh(
             }
         }
     }
-    let mut triangles = Vec::with_capacity(2 * (n_around - 1) * (n_down - 1));
-    for i in 0..n_down - 1 {
-        for j in 0..n_around - 1 {
-            let a = i * n_around + j;
-            let (b, c, d) = (a + 1, a + 1 + n_around, a + n_around);
-            if (i + j) % 2 == 0 {
-                triangles.push([a, b, c]);
-                triangles.push([a, c, d]);
-            } else {
-                triangles.push([a, b, d]);
-                triangles.push([b, c, d]);
-            }
-        }
-    }
+    let triangles = super::grid::grid_triangles(n_around, n_down);
     Ok(TriMesh {
         positions,
         rest,

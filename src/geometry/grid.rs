@@ -27,6 +27,17 @@ pub fn grid_mesh(width: f64, height: f64, nx: usize, ny: usize) -> Result<TriMes
             rest.push([x + 0.5 * width, y + 0.5 * height]);
         }
     }
+    let triangles = grid_triangles(nx, ny);
+    Ok(TriMesh {
+        positions,
+        rest,
+        triangles,
+    })
+}
+
+/// Triangles of an `nx` × `ny` vertex grid (vertex `(i, j)` at `i * nx + j`), each quad split
+/// along alternating diagonals so the mesh has no preferred shear direction.
+pub fn grid_triangles(nx: usize, ny: usize) -> Vec<[usize; 3]> {
     let mut triangles = Vec::with_capacity(2 * (nx - 1) * (ny - 1));
     for i in 0..ny - 1 {
         for j in 0..nx - 1 {
@@ -41,9 +52,5 @@ pub fn grid_mesh(width: f64, height: f64, nx: usize, ny: usize) -> Result<TriMes
             }
         }
     }
-    Ok(TriMesh {
-        positions,
-        rest,
-        triangles,
-    })
+    triangles
 }

@@ -96,16 +96,8 @@ pub fn write_obj(
 /// on malformed numbers or faces, out-of-range indices, face corners without texture
 /// coordinates, zero-area rest triangles, a file without faces, or an otherwise invalid mesh.
 pub fn read_obj(path: &Path) -> Result<TriMesh, GeometryError> {
-    let err = |line: usize, message: String| GeometryError::Parse {
-        path: path.to_path_buf(),
-        line,
-        message,
-    };
-    let text = fs::read_to_string(path).map_err(|source| GeometryError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let (mesh, face_lines) = parse(&text, true).map_err(|(line, message)| err(line, message))?;
+    let err = |line: usize, message: String| parse_error(path, line, message);
+    let (mesh, face_lines) = read_and_parse(path, true)?;
     if mesh.triangles.is_empty() {
         return Err(err(
             0,
@@ -131,20 +123,28 @@ pub fn read_obj(path: &Path) -> Result<TriMesh, GeometryError> {
 /// fanned; texture coordinates and normals are ignored. Errors as [`read_obj`] (file and line);
 /// the mesh's own validity (degenerate or non-manifold faces) is left to its user.
 pub fn read_obj_surface(path: &Path) -> Result<(Vec<Vec3>, Vec<[usize; 3]>), GeometryError> {
-    let err = |line: usize, message: String| GeometryError::Parse {
+    let (mesh, _) = read_and_parse(path, false)?;
+    if mesh.triangles.is_empty() {
+        return Err(parse_error(path, 0, "no faces (`f` lines)".into()));
+    }
+    Ok((mesh.positions, mesh.triangles))
+}
+
+fn parse_error(path: &Path, line: usize, message: String) -> GeometryError {
+    GeometryError::Parse {
         path: path.to_path_buf(),
         line,
         message,
-    };
+    }
+}
+
+/// Reads and parses `path` (see [`parse`]), errors naming the file and line.
+fn read_and_parse(path: &Path, need_uv: bool) -> Result<(TriMesh, Vec<usize>), GeometryError> {
     let text = fs::read_to_string(path).map_err(|source| GeometryError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    let (mesh, _) = parse(&text, false).map_err(|(line, message)| err(line, message))?;
-    if mesh.triangles.is_empty() {
-        return Err(err(0, "no faces (`f` lines)".into()));
-    }
-    Ok((mesh.positions, mesh.triangles))
+    parse(&text, need_uv).map_err(|(line, message)| parse_error(path, line, message))
 }
 
 /// Why texture coordinates are required.
