@@ -274,24 +274,38 @@ impl SelfCollision {
         self.d_in.extend_from_slice(&self.d);
 
         // candidates stay valid while no displacement changes by more than `margin`
-        let margin = thickness;
+        let margin = 0.5 * thickness;
         let pad = thickness + margin;
         // 1. repulsion of close, approaching pairs
         let debug = std::env::var_os("EMILION_DEBUG_SELF").is_some();
         let tdbg = std::time::Instant::now();
         self.broad_phase(x0, pad);
         let pairs = self.vf.len() + self.ee.len();
-        for k in 0..pairs {
+        // close pairs found in parallel (positions at the start only), answered in order
+        let close: Vec<Vec<(usize, f64, [f64; 4], Vec3)>> = {
+            let this = &*self;
+            let chunk = 2048;
+            (0..pairs.div_ceil(chunk))
+                .into_par_iter()
+                .map(|c| {
+                    let mut out = Vec::new();
+                    for k in c * chunk..((c + 1) * chunk).min(pairs) {
+                        let vs = this.pair_vertices(k);
+                        if separated(x0, &vs, k < this.vf.len(), thickness) {
+                            continue;
+                        }
+                        if let Some((dist, w, nrm)) = this.proximity(k, x0, &vs) {
+                            if dist < thickness {
+                                out.push((k, dist, w, nrm));
+                            }
+                        }
+                    }
+                    out
+                })
+                .collect()
+        };
+        for (k, dist, w, nrm) in close.into_iter().flatten() {
             let vs = self.pair_vertices(k);
-            if separated(x0, &vs, k < self.vf.len(), thickness) {
-                continue;
-            }
-            let Some((dist, w, nrm)) = self.proximity(k, x0, &vs) else {
-                continue;
-            };
-            if dist >= thickness {
-                continue;
-            }
             rep.proximities += 1;
             let target = PUSH * (thickness - dist);
             let dn = Self::push_apart(&mut self.d, inv_mass, &vs, &w, &nrm, target);
@@ -463,6 +477,9 @@ impl SelfCollision {
                     let vs = self.pair_vertices(k);
                     let xs = vs.map(|i| x0[i]);
                     let ds = vs.map(|i| d[i]);
+                    if swept_apart(&xs, &ds, k < nvf, 0.1 * thickness) {
+                        continue;
+                    }
                     let hit = if k < nvf {
                         vertex_face_ccd(xs, ds, thickness * 0.1)
                     } else {
@@ -620,6 +637,27 @@ fn separated(x: &[Vec3], vs: &[usize; 4], vertex_face: bool, gap: f64) -> bool {
             } else {
                 lo1 = lo1.min(c);
                 hi1 = hi1.max(c);
+            }
+        }
+        lo0 > hi1 + gap || lo1 > hi0 + gap
+    })
+}
+
+/// Whether the boxes swept by the two primitives of a candidate over the step (from `x` by
+/// `d`) are more than `gap` apart along some axis (then their motions cannot meet).
+#[inline]
+fn swept_apart(x: &[Vec3; 4], d: &[Vec3; 4], vertex_face: bool, gap: f64) -> bool {
+    let split = if vertex_face { 1 } else { 2 };
+    (0..3).any(|a| {
+        let (mut lo0, mut hi0, mut lo1, mut hi1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+        for m in 0..4 {
+            let (p, q) = (x[m][a], x[m][a] + d[m][a]);
+            if m < split {
+                lo0 = lo0.min(p.min(q));
+                hi0 = hi0.max(p.max(q));
+            } else {
+                lo1 = lo1.min(p.min(q));
+                hi1 = hi1.max(p.max(q));
             }
         }
         lo0 > hi1 + gap || lo1 > hi0 + gap
