@@ -20,7 +20,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     if let Ok(mu) = std::env::var("MU") {
         let mu: f64 = mu.parse()?;
-        sim.contact.settings.friction = emilion::contact::FrictionCoefficients { static_: mu, kinetic: mu };
+        sim.contact.settings.friction = emilion::contact::FrictionCoefficients {
+            static_: mu,
+            kinetic: mu,
+        };
         for b in &mut sim.contact.bodies {
             b.friction = sim.contact.settings.friction;
         }

@@ -51,7 +51,16 @@ fn main() {
         );
         let t = Instant::now();
         for _ in 0..reps {
-            ls.sweep(&asm.a, LineDir::Warp, &x, &mut y, &fixed, None, [0, 1, 2], false);
+            ls.sweep(
+                &asm.a,
+                LineDir::Warp,
+                &x,
+                &mut y,
+                &fixed,
+                None,
+                [0, 1, 2],
+                false,
+            );
         }
         println!(
             "sweep warp {:.3} ms",
@@ -59,7 +68,16 @@ fn main() {
         );
         let t = Instant::now();
         for _ in 0..reps {
-            ls.sweep(&asm.a, LineDir::Weft, &x, &mut y, &fixed, None, [0, 1, 2], false);
+            ls.sweep(
+                &asm.a,
+                LineDir::Weft,
+                &x,
+                &mut y,
+                &fixed,
+                None,
+                [0, 1, 2],
+                false,
+            );
         }
         println!(
             "sweep weft {:.3} ms",

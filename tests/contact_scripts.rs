@@ -157,7 +157,8 @@ fn inside_mesh(p: [f64; 3], body: &TriMesh, pts: &[[f64; 3]]) -> bool {
 
 #[test]
 fn mannequin_walk_two_seconds_without_penetration() {
-    let dir = run("mannequin_walk", &[]);
+    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data");
+    let dir = run("mannequin_walk", &[("data", data)]);
     assert_eq!(frames(&dir), 10);
     let skirt = read_obj(&dir.join("skirt.obj")).unwrap();
     let body = read_plain_obj(&dir.join("mannequin.obj"));
