@@ -537,19 +537,5 @@ impl Collisions {
         }
         self.stats.min_distance = min;
         self.stats.penetrating = inside;
-        if inside > 0 && std::env::var_os("EMILION_DEBUG_CONTACT").is_some() {
-            for (i, xi) in x.iter().enumerate() {
-                for b in bodies {
-                    if let Some(p) = b.proximity(xi, f64::INFINITY) {
-                        if p.distance < 0.0 {
-                            eprintln!(
-                                "inside: vertex {i} at {:.3?} depth {:.4} normal {:.2?} slot body {} stuck {} filter-last {:.3e}",
-                                xi.as_slice(), p.distance, p.normal.as_slice(), self.slots[i].body as i64, self.slots[i].stuck, self.last_impulse[i]
-                            );
-                        }
-                    }
-                }
-            }
-        }
     }
 }

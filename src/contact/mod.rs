@@ -9,6 +9,7 @@ pub mod ccd;
 pub mod character;
 pub mod collisions;
 pub mod error;
+pub mod impact_zone;
 pub mod mesh_body;
 pub mod primitives;
 pub mod self_collision;

@@ -11,26 +11,27 @@
 //! Velocities change by the displacement corrections over dt. Candidate pairs come from a
 //! spatial hash of swept boxes (see [`SpatialHash`]); pairs sharing a vertex are skipped.
 
-use nalgebra::Rotation3;
 use rayon::prelude::*;
 
 use super::ccd::{edge_edge_ccd, vertex_face_ccd, CcdHit};
+use super::impact_zone::{find, rigid_motion, union};
 use super::primitives::{
     closest_point_triangle, closest_points_segments, segment_triangle_intersect,
 };
 use super::spatial_hash::{Aabb, SpatialHash};
-use crate::geometry::{Mat3, Vec3};
+use crate::geometry::Vec3;
 
 /// Repeated continuous-detection passes before impact zones take over.
 const CCD_PASSES: usize = 6;
 /// Impact-zone rounds before the last-resort stop.
 const ZONE_ROUNDS: usize = 24;
-/// Largest rotation (rad) of an impact zone in one step.
-const MAX_TURN: f64 = 0.2;
 /// Pairs are left this fraction of the thickness apart after a continuous hit.
 const SEPARATION: f64 = 0.25;
 /// Fraction of the overlap recovered per step by the repulsion push.
 const PUSH: f64 = 0.2;
+
+/// A candidate closer than the thickness: (candidate, distance, Bridson weights, unit normal).
+type ClosePair = (usize, f64, [f64; 4], Vec3);
 
 /// What one call of [`SelfCollision::respond`] did.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -277,12 +278,10 @@ impl SelfCollision {
         let margin = 0.5 * thickness;
         let pad = thickness + margin;
         // 1. repulsion of close, approaching pairs
-        let debug = std::env::var_os("EMILION_DEBUG_SELF").is_some();
-        let tdbg = std::time::Instant::now();
         self.broad_phase(x0, pad);
         let pairs = self.vf.len() + self.ee.len();
         // close pairs found in parallel (positions at the start only), answered in order
-        let close: Vec<Vec<(usize, f64, [f64; 4], Vec3)>> = {
+        let close: Vec<Vec<ClosePair>> = {
             let this = &*self;
             let chunk = 2048;
             (0..pairs.div_ceil(chunk))
@@ -321,15 +320,6 @@ impl SelfCollision {
             }
         }
 
-        if debug {
-            eprintln!(
-                "self: {} vf, {} ee candidates, broad+proximity {:.2} ms",
-                self.vf.len(),
-                self.ee.len(),
-                tdbg.elapsed().as_secs_f64() * 1e3
-            );
-        }
-        let tdbg = std::time::Instant::now();
         // 2. continuous detection passes
         let mut hits = Vec::new();
         let mut resolved = false;
@@ -361,13 +351,6 @@ impl SelfCollision {
             }
         }
 
-        if debug {
-            eprintln!(
-                "self: ccd {} passes {:.2} ms",
-                rep.passes,
-                tdbg.elapsed().as_secs_f64() * 1e3
-            );
-        }
         // 3. impact zones
         if !resolved {
             self.parent.clear();
@@ -414,9 +397,6 @@ impl SelfCollision {
             }
         }
 
-        if debug && (rep.zone_rounds > 0 || rep.stopped > 0) {
-            eprintln!("self: {rep:?}");
-        }
         self.moved.clear();
         self.moved.resize(n, false);
         for i in 0..n {
@@ -525,52 +505,8 @@ impl SelfCollision {
                 end += 1;
             }
             let zone: Vec<usize> = members[start..end].iter().map(|m| m.1 as usize).collect();
-            self.rigid_motion(&zone, x0, inv_mass);
+            rigid_motion(&mut self.d, &zone, x0, inv_mass);
             start = end;
-        }
-    }
-
-    fn rigid_motion(&mut self, zone: &[usize], x0: &[Vec3], inv_mass: &[f64]) {
-        let pinned: Vec<usize> = zone
-            .iter()
-            .copied()
-            .filter(|&i| inv_mass[i] == 0.0)
-            .collect();
-        if !pinned.is_empty() {
-            // a zone holding prescribed vertices follows their mean displacement
-            let mean = pinned.iter().map(|&i| self.d[i]).sum::<Vec3>() / pinned.len() as f64;
-            for &i in zone {
-                if inv_mass[i] != 0.0 {
-                    self.d[i] = mean;
-                }
-            }
-            return;
-        }
-        let mass = |i: usize| 1.0 / inv_mass[i];
-        let m: f64 = zone.iter().map(|&i| mass(i)).sum();
-        let c = zone.iter().map(|&i| x0[i] * mass(i)).sum::<Vec3>() / m;
-        let dc = zone.iter().map(|&i| self.d[i] * mass(i)).sum::<Vec3>() / m;
-        let mut l = Vec3::zeros();
-        let mut inertia = Mat3::zeros();
-        for &i in zone {
-            let r = x0[i] - c;
-            l += (r.cross(&(self.d[i] - dc))) * mass(i);
-            inertia += (Mat3::identity() * r.norm_squared() - r * r.transpose()) * mass(i);
-        }
-        // a nearly collinear zone has a nearly singular inertia: solve in the least-squares
-        // sense, and never turn a zone by more than MAX_TURN in one step
-        let omega = inertia
-            .pseudo_inverse(1e-9 * inertia.norm())
-            .map_or(Vec3::zeros(), |inv| inv * l);
-        let omega = if omega.norm() > MAX_TURN {
-            omega * (MAX_TURN / omega.norm())
-        } else {
-            omega
-        };
-        let rot = Rotation3::new(omega);
-        for &i in zone {
-            let r = x0[i] - c;
-            self.d[i] = dc + rot * r - r;
         }
     }
 
@@ -662,27 +598,4 @@ fn swept_apart(x: &[Vec3; 4], d: &[Vec3; 4], vertex_face: bool, gap: f64) -> boo
         }
         lo0 > hi1 + gap || lo1 > hi0 + gap
     })
-}
-
-fn find(parent: &mut [u32], i: usize) -> u32 {
-    let mut r = i as u32;
-    while parent[r as usize] != r {
-        r = parent[r as usize];
-    }
-    let mut k = i as u32;
-    while parent[k as usize] != r {
-        let next = parent[k as usize];
-        parent[k as usize] = r;
-        k = next;
-    }
-    r
-}
-
-fn union(parent: &mut [u32], a: usize, b: usize) {
-    let (ra, rb) = (find(parent, a), find(parent, b));
-    if ra != rb {
-        // the smaller index is the root: deterministic
-        let (lo, hi) = (ra.min(rb), ra.max(rb));
-        parent[hi as usize] = lo;
-    }
 }
