@@ -290,7 +290,8 @@ impl SelfCollision {
                     let mut out = Vec::new();
                     for k in c * chunk..((c + 1) * chunk).min(pairs) {
                         let vs = this.pair_vertices(k);
-                        if separated(x0, &vs, k < this.vf.len(), thickness) {
+                        let xs = vs.map(|i| x0[i]);
+                        if swept_apart(&xs, &[Vec3::zeros(); 4], k < this.vf.len(), thickness) {
                             continue;
                         }
                         if let Some((dist, w, nrm)) = this.proximity(k, x0, &vs) {
@@ -556,27 +557,6 @@ impl SelfCollision {
             })
             .sum()
     }
-}
-
-/// Whether the two primitives of a candidate (vertex and triangle, or two edges) at `x` have
-/// bounding boxes more than `gap` apart along some axis (then they are not in proximity).
-#[inline]
-fn separated(x: &[Vec3], vs: &[usize; 4], vertex_face: bool, gap: f64) -> bool {
-    let split = if vertex_face { 1 } else { 2 };
-    (0..3).any(|a| {
-        let (mut lo0, mut hi0, mut lo1, mut hi1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-        for (m, &i) in vs.iter().enumerate() {
-            let c = x[i][a];
-            if m < split {
-                lo0 = lo0.min(c);
-                hi0 = hi0.max(c);
-            } else {
-                lo1 = lo1.min(c);
-                hi1 = hi1.max(c);
-            }
-        }
-        lo0 > hi1 + gap || lo1 > hi0 + gap
-    })
 }
 
 /// Whether the boxes swept by the two primitives of a candidate over the step (from `x` by
