@@ -71,6 +71,14 @@ fn frames(dir: &Path) -> usize {
         .count()
 }
 
+/// Height of the lowest vertex (m).
+fn lowest_z(m: &TriMesh) -> f64 {
+    m.positions
+        .iter()
+        .map(|p| p.z)
+        .fold(f64::INFINITY, f64::min)
+}
+
 fn no_self_intersection(m: &TriMesh, what: &str) {
     let k = count_edge_triangle_intersections(&points(m), &m.triangles);
     assert_eq!(
@@ -91,11 +99,7 @@ fn drape_sphere_no_penetration_no_intersection() {
         .fold(f64::INFINITY, f64::min);
     assert!(worst >= 0.0, "a vertex is {} m inside the sphere", -worst);
     // it draped: the cloth hangs below the sphere's equator
-    let lowest = cloth
-        .positions
-        .iter()
-        .map(|p| p.z)
-        .fold(f64::INFINITY, f64::min);
+    let lowest = lowest_z(&cloth);
     assert!(
         lowest < -0.05,
         "cloth lowest point {lowest} m: it did not drape"
@@ -116,11 +120,7 @@ fn drape_table_no_penetration_no_intersection() {
         );
     }
     // the corners hang below the table top: folds over the corners
-    let lowest = cloth
-        .positions
-        .iter()
-        .map(|p| p.z)
-        .fold(f64::INFINITY, f64::min);
+    let lowest = lowest_z(&cloth);
     assert!(
         lowest < 0.6,
         "lowest point {lowest} m: the cloth did not fall over the edges"
