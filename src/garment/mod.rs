@@ -1,0 +1,30 @@
+//! Garments from 2D sewing patterns: pattern pieces and seams ([`pattern`]), their files
+//! (JSON, SVG, DXF-AAMA), meshing of the pieces, automatic pre-positioning around a
+//! mannequin and sewing into one cloth.
+
+pub mod body_frame;
+pub mod error;
+pub mod expand;
+pub mod json;
+pub mod mesh;
+mod mesh_boundary;
+pub mod outline;
+pub mod pattern;
+pub mod silhouette;
+pub mod svg;
+mod svg_path;
+pub mod table;
+pub mod validate;
+mod xml;
+
+pub use body_frame::BodyFrame;
+pub use error::PatternError;
+pub use json::{read_pattern_json, write_pattern_json};
+pub use mesh::{mesh_pattern, GarmentMesh, MeshParameters, PieceMesh, SeamMesh};
+pub use outline::{FlatOutline, FlatPoint};
+pub use pattern::{
+    Copies, Corner, EdgeRef, Outline, Pattern, Piece, Placement, Seam, Segment, Side, P2,
+};
+pub use silhouette::{Landmarks, Silhouettes};
+pub use svg::{read_pattern_svg, SvgOptions};
+pub use table::{read_garment, GarmentTable, PartUse};
