@@ -10,6 +10,8 @@ pub mod mesh;
 mod mesh_boundary;
 pub mod outline;
 pub mod pattern;
+pub mod preposition;
+pub mod shell;
 pub mod silhouette;
 pub mod svg;
 mod svg_path;
@@ -25,6 +27,7 @@ pub use outline::{FlatOutline, FlatPoint};
 pub use pattern::{
     Copies, Corner, EdgeRef, Outline, Pattern, Piece, Placement, Seam, Segment, Side, P2,
 };
+pub use preposition::{preposition, PrepositionParameters, PrepositionReport};
 pub use silhouette::{Landmarks, Silhouettes};
 pub use svg::{read_pattern_svg, SvgOptions};
 pub use table::{read_garment, GarmentTable, PartUse};

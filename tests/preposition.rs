@@ -1,0 +1,140 @@
+//! Pre-positioning of meshed patterns around the MakeHuman mannequin: every vertex ends
+//! outside the skin, edges keep their rest lengths (mean strain under 10 %), and the side seams
+//! of front and back pieces meet. Patterns are built here by hand so that the expected figures
+//! are known: a straight skirt whose width is given.
+
+use std::path::PathBuf;
+use std::sync::OnceLock;
+
+use emilion::body::Mannequin;
+use emilion::contact::MeshBody;
+use emilion::garment::{
+    mesh_pattern, preposition, BodyFrame, Copies, Corner, EdgeRef, Landmarks, MeshParameters,
+    Outline, Pattern, Piece, Placement, PrepositionParameters, Seam, Segment, Side, Silhouettes,
+};
+
+struct Body {
+    sil: Silhouettes,
+    marks: Landmarks,
+    skin: MeshBody,
+}
+
+fn body() -> &'static Body {
+    static B: OnceLock<Body> = OnceLock::new();
+    B.get_or_init(|| {
+        let dir = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data"))
+            .join("bodies/makehuman");
+        let m = Mannequin::load_makehuman(&dir).unwrap();
+        let f = BodyFrame::of(m.rest_positions(), m.triangles()).unwrap();
+        let sil = Silhouettes::of(f, m.rest_positions(), m.triangles(), 0.005).unwrap();
+        let marks = sil.landmarks().unwrap();
+        let skin = MeshBody::new("skin", m.rest_positions().to_vec(), m.triangles()).unwrap();
+        Body { sil, marks, skin }
+    })
+}
+
+fn rect(name: &str, w: f64, h: f64, side: Side) -> Piece {
+    let c = |n: &str, x: f64, y: f64| Corner {
+        name: n.into(),
+        at: [x, y],
+        segment: Segment::Line,
+    };
+    Piece {
+        name: name.into(),
+        outline: Outline {
+            corners: vec![
+                c("bl", 0.0, 0.0),
+                c("br", w, 0.0),
+                c("tr", w, h),
+                c("tl", 0.0, h),
+            ],
+        },
+        grain: [[w / 2.0, 0.1], [w / 2.0, h - 0.1]],
+        seam_allowance: 0.0,
+        notches: vec![],
+        fold: None,
+        copies: Copies::One,
+        placement: Some(Placement {
+            side,
+            anchor: "tl".into(),
+            x: -w / 2.0,
+            level: "waist".into(),
+            dz: 0.02,
+        }),
+    }
+}
+
+fn edge(piece: &str, from: &str, to: &str) -> EdgeRef {
+    EdgeRef {
+        piece: piece.into(),
+        from: from.into(),
+        to: to.into(),
+    }
+}
+
+/// A straight skirt of two rectangles `w` wide, `h` long, sewn at the sides.
+fn skirt(w: f64, h: f64) -> Pattern {
+    Pattern {
+        name: "tube".into(),
+        source: "test".into(),
+        pieces: vec![
+            rect("front", w, h, Side::Front),
+            rect("back", w, h, Side::Back),
+        ],
+        seams: vec![
+            // front's right edge (body's left) with back's left edge (body's left)
+            Seam {
+                name: "left".into(),
+                a: edge("front", "br", "tr"),
+                b: edge("back", "tl", "bl"),
+                aligned: false,
+            },
+            Seam {
+                name: "right".into(),
+                a: edge("back", "br", "tr"),
+                b: edge("front", "tl", "bl"),
+                aligned: false,
+            },
+        ],
+    }
+}
+
+#[test]
+fn a_loose_skirt_is_placed_outside_the_body_with_little_strain() {
+    let b = body();
+    let pat = skirt(0.56, 0.5);
+    let g = mesh_pattern(
+        &pat,
+        &MeshParameters {
+            edge_length: 0.015,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let (x, rep) = preposition(
+        &pat,
+        &g,
+        &b.sil,
+        &b.marks,
+        &b.skin,
+        &PrepositionParameters::default(),
+    )
+    .unwrap();
+    eprintln!("{rep:?}");
+    assert_eq!(rep.inside, 0);
+    assert!(rep.min_distance > 0.0);
+    assert!(rep.mean_strain < 0.10, "mean strain {}", rep.mean_strain);
+    // side seams meet: the widest gap between paired seam vertices
+    let gap = g
+        .seams
+        .iter()
+        .flat_map(|s| s.pairs.iter().map(|&(a, c)| (x[a] - x[c]).norm()))
+        .fold(0.0f64, f64::max);
+    eprintln!("largest seam gap {gap}");
+    assert!(gap < 0.02, "seam gap {gap}");
+    // the waist row is at the waist: top corners within a few cm of the landmark height
+    let f = b.sil.frame;
+    let tl = g.pieces[0].corners.iter().find(|c| c.0 == "tl").unwrap().1;
+    let h = f.to_body(&x[tl])[1];
+    assert!((h - (b.marks.waist + 0.02)).abs() < 0.01, "{h}");
+}
