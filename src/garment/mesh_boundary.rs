@@ -1,0 +1,403 @@
+//! Boundary sampling for meshing ([`super::mesh`]): the outline of every piece cut into boundary
+//! vertices at the target edge length, with the two edges of each seam sampled at the same
+//! arc-length fractions so that their vertices pair one to one.
+//!
+//! Owns its own Bézier evaluation and arc-length parameterisation (dense chord tables), the
+//! planning of seam fractions, and the check that a sampled outline is a simple polygon.
+
+use super::error::PatternError;
+use super::pattern::{Pattern, Piece, Segment, P2};
+
+/// Chords per cubic in the arc-length table.
+const TABLE: usize = 512;
+/// Two edge fractions closer than this (relative to the edge length) are the same point.
+const SAME: f64 = 1e-9;
+
+/// One outline segment with an arc-length parameterisation.
+pub(super) struct Curve {
+    p: [P2; 4],
+    line: bool,
+    /// Arc length at t = i / TABLE (cubics only).
+    cum: Vec<f64>,
+    pub length: f64,
+}
+
+fn lerp(a: P2, b: P2, t: f64) -> P2 {
+    [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t]
+}
+
+fn dist(a: P2, b: P2) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+/// The cubic Bézier with control points `p` at parameter `t`.
+pub(super) fn bezier(p: &[P2; 4], t: f64) -> P2 {
+    let s = 1.0 - t;
+    let (a, b, c, d) = (s * s * s, 3.0 * s * s * t, 3.0 * s * t * t, t * t * t);
+    [
+        a * p[0][0] + b * p[1][0] + c * p[2][0] + d * p[3][0],
+        a * p[0][1] + b * p[1][1] + c * p[2][1] + d * p[3][1],
+    ]
+}
+
+impl Curve {
+    /// The segment leaving `from` with shape `seg` and ending at `to`.
+    pub fn new(from: P2, seg: &Segment, to: P2) -> Self {
+        match *seg {
+            Segment::Line => Curve {
+                p: [from, from, to, to],
+                line: true,
+                cum: Vec::new(),
+                length: dist(from, to),
+            },
+            Segment::Cubic { c1, c2 } => {
+                let p = [from, c1, c2, to];
+                let mut cum = Vec::with_capacity(TABLE + 1);
+                cum.push(0.0);
+                let mut prev = from;
+                for i in 1..=TABLE {
+                    let q = bezier(&p, i as f64 / TABLE as f64);
+                    cum.push(cum[i - 1] + dist(prev, q));
+                    prev = q;
+                }
+                let length = cum[TABLE];
+                Curve {
+                    p,
+                    line: false,
+                    cum,
+                    length,
+                }
+            }
+        }
+    }
+
+    /// The point at arc length `s` from the start (0 ≤ s ≤ length).
+    pub fn point_at(&self, s: f64) -> P2 {
+        if self.line {
+            return lerp(self.p[0], self.p[3], s / self.length);
+        }
+        let i = self.cum.partition_point(|&c| c <= s).clamp(1, TABLE) - 1;
+        let span = self.cum[i + 1] - self.cum[i];
+        let f = if span > 0.0 {
+            ((s - self.cum[i]) / span).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        bezier(&self.p, (i as f64 + f) / TABLE as f64)
+    }
+}
+
+/// A piece's outline sampled into a closed loop of boundary points, counter-clockwise.
+pub(super) struct PieceBoundary {
+    /// The boundary points (drawing coordinates, m), starting at corner 0.
+    pub points: Vec<P2>,
+    /// Loop index of each corner, in outline order.
+    pub corners: Vec<usize>,
+}
+
+/// The boundary sampling of a whole pattern.
+pub(super) struct Plan {
+    /// Per piece.
+    pub boundaries: Vec<PieceBoundary>,
+    /// Per seam.
+    pub seams: Vec<SeamPlan>,
+}
+
+/// The boundary vertices of one seam.
+pub(super) struct SeamPlan {
+    /// The pieces of edges a and b.
+    pub pieces: (usize, usize),
+    /// Pairs of loop indices (on a's piece, on b's piece), from a.from to a.to.
+    pub pairs: Vec<(usize, usize)>,
+}
+
+/// The name the errors give the pattern.
+pub(super) fn source_name(pattern: &Pattern) -> String {
+    if pattern.source.is_empty() {
+        pattern.name.clone()
+    } else {
+        pattern.source.clone()
+    }
+}
+
+/// A seam edge resolved to outline segments.
+struct EdgePath {
+    piece: usize,
+    from: usize,
+    /// The segments it runs along, in order.
+    segs: Vec<usize>,
+    /// Arc length at the start of each segment, and the total at the end.
+    cum: Vec<f64>,
+}
+
+/// Where a fraction of an edge falls: on a corner, or inside a segment at an arc length.
+enum Loc {
+    Corner(usize),
+    On(usize, f64),
+}
+
+impl EdgePath {
+    fn length(&self) -> f64 {
+        *self.cum.last().unwrap()
+    }
+
+    fn locate(&self, f: f64, n_corners: usize) -> Loc {
+        let len = self.length();
+        let s = f * len;
+        for (k, &c) in self.cum.iter().enumerate() {
+            if (s - c).abs() <= 2.0 * SAME * len {
+                return Loc::Corner((self.from + k) % n_corners);
+            }
+        }
+        let i = self.cum.partition_point(|&c| c < s) - 1;
+        Loc::On(self.segs[i], s - self.cum[i])
+    }
+
+    /// The fractions of the corners strictly inside the edge.
+    fn corner_fractions(&self) -> impl Iterator<Item = f64> + '_ {
+        let len = self.length();
+        self.cum[1..self.cum.len() - 1].iter().map(move |c| c / len)
+    }
+}
+
+fn corner_index(piece: &Piece, name: &str) -> Option<usize> {
+    piece.outline.corners.iter().position(|c| c.name == name)
+}
+
+/// Samples every piece's outline at edge length `h`, seams first (same fractions on both
+/// edges), the remaining segments uniformly; checks each loop is a simple CCW polygon.
+pub(super) fn plan(pattern: &Pattern, curves: &[Vec<Curve>], h: f64) -> Result<Plan, PatternError> {
+    let src = source_name(pattern);
+    let seam_err = |seam: &str, message: String| PatternError::Seam {
+        source_name: src.clone(),
+        seam: seam.to_string(),
+        message,
+    };
+    // per piece, per segment: the arc lengths of the points inside it, and which seam owns it
+    let mut inner: Vec<Vec<Vec<f64>>> = curves.iter().map(|c| vec![Vec::new(); c.len()]).collect();
+    let mut owner: Vec<Vec<Option<usize>>> = curves.iter().map(|c| vec![None; c.len()]).collect();
+    let mut seam_plans = Vec::with_capacity(pattern.seams.len());
+    for (si, seam) in pattern.seams.iter().enumerate() {
+        let mut paths = Vec::with_capacity(2);
+        for e in [&seam.a, &seam.b] {
+            let Some(p) = pattern.pieces.iter().position(|q| q.name == e.piece) else {
+                return Err(seam_err(&seam.name, format!("no piece '{}'", e.piece)));
+            };
+            let piece = &pattern.pieces[p];
+            let corner = |name: &str| {
+                corner_index(piece, name).ok_or_else(|| {
+                    seam_err(
+                        &seam.name,
+                        format!("piece '{}' has no corner '{name}'", piece.name),
+                    )
+                })
+            };
+            let (from, to) = (corner(&e.from)?, corner(&e.to)?);
+            if from == to {
+                return Err(seam_err(
+                    &seam.name,
+                    format!("edge of piece '{}' from '{}' to itself", piece.name, e.from),
+                ));
+            }
+            let n = curves[p].len();
+            let mut path = EdgePath {
+                piece: p,
+                from,
+                segs: Vec::new(),
+                cum: vec![0.0],
+            };
+            let mut j = from;
+            while j != to {
+                if let Some(other) = owner[p][j] {
+                    return Err(seam_err(
+                        &seam.name,
+                        format!(
+                            "edge {}→{} of piece '{}' overlaps seam '{}'",
+                            e.from, e.to, piece.name, pattern.seams[other].name
+                        ),
+                    ));
+                }
+                owner[p][j] = Some(si);
+                path.segs.push(j);
+                path.cum
+                    .push(path.cum.last().unwrap() + curves[p][j].length);
+                j = (j + 1) % n;
+            }
+            paths.push(path);
+        }
+        let (b, a) = (paths.pop().unwrap(), paths.pop().unwrap());
+        // b's fraction g meets a's fraction f = g (aligned) or 1 - g
+        let to_a = |g: f64| if seam.aligned { g } else { 1.0 - g };
+        let mut fixed: Vec<f64> = [0.0, 1.0].into_iter().chain(a.corner_fractions()).collect();
+        fixed.extend(b.corner_fractions().map(to_a));
+        fixed.sort_by(f64::total_cmp);
+        fixed.dedup_by(|x, y| (*x - *y).abs() <= SAME);
+        let longest = a.length().max(b.length());
+        let mut fractions = vec![0.0];
+        for w in fixed.windows(2) {
+            let mut k = ((w[1] - w[0]) * longest / h).round().max(1.0) as usize;
+            if fixed.len() == 2 {
+                k = k.max(2);
+            }
+            fractions.extend((1..k).map(|i| w[0] + (w[1] - w[0]) * i as f64 / k as f64));
+            fractions.push(w[1]);
+        }
+        for &f in &fractions {
+            for (path, g) in [(&a, f), (&b, to_a(f))] {
+                if let Loc::On(j, s) = path.locate(g, curves[path.piece].len()) {
+                    inner[path.piece][j].push(s);
+                }
+            }
+        }
+        seam_plans.push((a, b, fractions, seam.aligned));
+    }
+    // the segments no seam covers, uniformly
+    for (p, segs) in curves.iter().enumerate() {
+        for (j, c) in segs.iter().enumerate() {
+            if owner[p][j].is_none() {
+                let k = (c.length / h).round().max(1.0) as usize;
+                inner[p][j].extend((1..k).map(|i| c.length * i as f64 / k as f64));
+            }
+        }
+    }
+    // the loops
+    let mut boundaries = Vec::with_capacity(curves.len());
+    let mut first = Vec::with_capacity(curves.len()); // per piece, per segment: loop index of its first inner point
+    for (p, segs) in curves.iter().enumerate() {
+        let mut points = Vec::new();
+        let mut corners = Vec::with_capacity(segs.len());
+        let mut starts = Vec::with_capacity(segs.len());
+        for (j, c) in segs.iter().enumerate() {
+            corners.push(points.len());
+            points.push(pattern.pieces[p].outline.corners[j].at);
+            let list = &mut inner[p][j];
+            list.sort_by(f64::total_cmp);
+            starts.push(points.len());
+            points.extend(list.iter().map(|&s| c.point_at(s)));
+        }
+        check_simple(&points, &corners, &pattern.pieces[p], &src)?;
+        boundaries.push(PieceBoundary { points, corners });
+        first.push(starts);
+    }
+    let index = |path: &EdgePath, g: f64| -> usize {
+        let p = path.piece;
+        match path.locate(g, curves[p].len()) {
+            Loc::Corner(k) => boundaries[p].corners[k],
+            Loc::On(j, s) => first[p][j] + inner[p][j].partition_point(|&x| x < s),
+        }
+    };
+    let seams = seam_plans
+        .iter()
+        .map(|(a, b, fractions, aligned)| SeamPlan {
+            pieces: (a.piece, b.piece),
+            pairs: fractions
+                .iter()
+                .map(|&f| (index(a, f), index(b, if *aligned { f } else { 1.0 - f })))
+                .collect(),
+        })
+        .collect();
+    Ok(Plan { boundaries, seams })
+}
+
+/// Twice the signed area of a closed polygon (shoelace).
+pub(super) fn signed_area2(points: &[P2]) -> f64 {
+    let n = points.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (points[i], points[(i + 1) % n]);
+            a[0] * b[1] - b[0] * a[1]
+        })
+        .sum()
+}
+
+fn orient(a: P2, b: P2, c: P2) -> f64 {
+    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+}
+
+/// Whether closed segments `ab` and `cd` share a point.
+fn segments_meet(a: P2, b: P2, c: P2, d: P2) -> bool {
+    let (d1, d2) = (orient(c, d, a), orient(c, d, b));
+    let (d3, d4) = (orient(a, b, c), orient(a, b, d));
+    if d1 * d2 < 0.0 && d3 * d4 < 0.0 {
+        return true;
+    }
+    let on = |p: P2, q: P2, r: P2, o: f64| {
+        o == 0.0
+            && r[0] >= p[0].min(q[0])
+            && r[0] <= p[0].max(q[0])
+            && r[1] >= p[1].min(q[1])
+            && r[1] <= p[1].max(q[1])
+    };
+    on(c, d, a, d1) || on(c, d, b, d2) || on(a, b, c, d3) || on(a, b, d, d4)
+}
+
+/// Checks a sampled outline: at least three points, counter-clockwise, no two non-adjacent
+/// sides meeting and no adjacent sides folding back on each other.
+fn check_simple(
+    points: &[P2],
+    corners: &[usize],
+    piece: &Piece,
+    src: &str,
+) -> Result<(), PatternError> {
+    let err = |message: String| PatternError::Piece {
+        source_name: src.to_string(),
+        piece: piece.name.clone(),
+        message,
+    };
+    let n = points.len();
+    if n < 3 {
+        return Err(err(format!("outline has only {n} boundary points")));
+    }
+    if points.iter().flatten().any(|c| !c.is_finite()) {
+        return Err(err("outline has a non-finite coordinate".into()));
+    }
+    if signed_area2(points) <= 0.0 {
+        return Err(err(
+            "outline is not counter-clockwise (or has no area)".into()
+        ));
+    }
+    // sweep over the sides sorted by their lowest x
+    let side = |i: usize| (points[i], points[(i + 1) % n]);
+    let mut order: Vec<usize> = (0..n).collect();
+    let xmin = |i: usize| side(i).0[0].min(side(i).1[0]);
+    order.sort_by(|&i, &j| xmin(i).total_cmp(&xmin(j)).then(i.cmp(&j)));
+    for (k, &i) in order.iter().enumerate() {
+        let (a, b) = side(i);
+        let xmax = a[0].max(b[0]);
+        for &j in &order[k + 1..] {
+            if xmin(j) > xmax {
+                break;
+            }
+            let (c, d) = side(j);
+            let adjacent = (i + 1) % n == j || (j + 1) % n == i;
+            let meet = if adjacent {
+                // adjacent sides share one end; they must not overlap beyond it
+                let (p, q, r) = if (i + 1) % n == j {
+                    (a, b, d)
+                } else {
+                    (c, d, b)
+                };
+                orient(p, q, r) == 0.0
+                    && (r[0] - q[0]) * (p[0] - q[0]) + (r[1] - q[1]) * (p[1] - q[1]) > 0.0
+            } else {
+                segments_meet(a, b, c, d)
+            };
+            if meet {
+                // name the corners whose segments the two sides belong to
+                let name = |s: usize| {
+                    let k = corners.partition_point(|&c| c <= s) - 1;
+                    &piece.outline.corners[k].name
+                };
+                return Err(err(format!(
+                    "outline intersects itself: the segment after corner '{}' meets the \
+                     segment after corner '{}' (near ({:.4}, {:.4}))",
+                    name(i.min(j)),
+                    name(i.max(j)),
+                    c[0],
+                    c[1]
+                )));
+            }
+        }
+    }
+    Ok(())
+}
