@@ -282,6 +282,7 @@ impl Assembly {
                         SpringKind::Stretch { warp_weight } if warp_weight >= 0.5 => fr_warp,
                         SpringKind::Stretch { .. } => fr_weft,
                         SpringKind::Shear => fr_shear,
+                        SpringKind::Seam { .. } => None,
                     };
                     let axial_el = ev.axial;
                     if let Some(f) = fr {

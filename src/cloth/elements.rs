@@ -17,6 +17,13 @@ pub enum SpringKind {
     },
     /// Shear, measured through the stretch of a quad diagonal: γ = 2ε.
     Shear,
+    /// A sewing thread between two pieces: a linear spring of `stiffness` (N/m) that pulls
+    /// when longer than its rest length (which may be 0) and is slack when shorter. Not a
+    /// fabric law: `area` is unused.
+    Seam {
+        /// Stiffness (N/m).
+        stiffness: f64,
+    },
 }
 
 /// A two-particle spring. Its energy is `area · W(s)` with `s = gain · (L/L0 − 1)`, where
@@ -57,6 +64,17 @@ impl Spring {
         let d = xb - xa;
         let len = d.norm();
         let dir = if len > 0.0 { d / len } else { Vec3::zeros() };
+        if let SpringKind::Seam { stiffness } = self.kind {
+            let stretch = (len - self.rest).max(0.0);
+            let tension = stiffness * stretch;
+            return SpringEval {
+                dir,
+                tension,
+                axial: if stretch > 0.0 { stiffness } else { 0.0 },
+                transverse: if len > 0.0 { tension / len } else { 0.0 },
+                energy: 0.5 * stiffness * stretch * stretch,
+            };
+        }
         let eps = len / self.rest - 1.0;
         let (f, df, w) = match self.kind {
             SpringKind::Stretch { warp_weight } => {
@@ -77,6 +95,8 @@ impl Spring {
                 let (f, df, w) = law.shear(2.0 * eps);
                 (2.0 * f, 4.0 * df, w)
             }
+            // returned above
+            SpringKind::Seam { .. } => (0.0, 0.0, 0.0),
         };
         let tension = self.area * f / self.rest;
         let axial = self.area * df / (self.rest * self.rest);
@@ -112,6 +132,7 @@ impl Spring {
         let gain = match self.kind {
             SpringKind::Stretch { .. } => 1.0,
             SpringKind::Shear => 2.0,
+            SpringKind::Seam { .. } => return,
         };
         let coord = gain * (len / self.rest - 1.0);
         if st[0].is_nan() {

@@ -11,6 +11,7 @@ use super::constraints::{Attachment, ContactHook, Filter, ParticleFilter, Trajec
 use super::model::ClothModel;
 use super::multigrid::Multigrid;
 use super::pcg::{PcgResult, PcgWorkspace, Preconditioner};
+use super::sewing::Sewing;
 use super::state::ClothState;
 use super::stats::StepStats;
 use super::ClothError;
@@ -121,6 +122,8 @@ pub struct Simulation {
     pub contact: Collisions,
     /// Statistics of every step taken.
     pub stats: Vec<StepStats>,
+    /// The sewing schedule of a garment's seams, if any.
+    pub sewing: Option<Sewing>,
     /// Steps whose CG solve did not reach the tolerance.
     pub unconverged_steps: u64,
     filter: Filter,
@@ -166,6 +169,7 @@ impl Simulation {
             attachments: Vec::new(),
             hooks: Vec::new(),
             stats: Vec::new(),
+            sewing: None,
             unconverged_steps: 0,
             filter: Filter::new(n),
             z: vec![Vec3::zeros(); n],
@@ -330,6 +334,9 @@ impl Simulation {
     fn step_inner(&mut self) -> Result<StepStats, ClothError> {
         self.params.validate()?;
         let t_start = Instant::now();
+        if let Some(sew) = &self.sewing {
+            self.params.gravity = sew.update(&mut self.model, self.state.time);
+        }
         self.x_save.copy_from_slice(&self.state.x);
         self.v_save.copy_from_slice(&self.state.v);
         let mut st = match self.params.integrator {
@@ -345,6 +352,13 @@ impl Simulation {
             self.state.x.copy_from_slice(&self.x_save);
             self.state.v.copy_from_slice(&self.v_save);
             return Err(err);
+        }
+        if let Some(sew) = &self.sewing {
+            if sew.sewing_at(self.state.time) {
+                for v in self.state.v.iter_mut() {
+                    *v *= sew.damping;
+                }
+            }
         }
         self.contact_stats(&mut st);
         st.step = self.state.step;

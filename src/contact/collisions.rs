@@ -184,6 +184,13 @@ impl Collisions {
         self.self_collision = Some(SelfCollision::new(triangles, rest));
     }
 
+    /// Declares cloth vertices sewn together (seam pairs), so self-collision leaves them be.
+    pub fn set_welds(&mut self, n: usize, pairs: &[(usize, usize)]) {
+        if let Some(sc) = self.self_collision.as_mut() {
+            sc.set_welds(n, pairs);
+        }
+    }
+
     /// Pins cloth `particles` (now at `x`) to mesh body `body`: each follows the body vertex
     /// nearest to it in the body's rest pose (so that a waistband picks the waist, not a hand
     /// swinging by), keeping its present offset from it, turned with the vertex normal. With

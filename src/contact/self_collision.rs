@@ -67,6 +67,8 @@ pub struct SelfCollision {
     d_bp: Vec<Vec3>,
     moved: Vec<bool>,
     parent: Vec<u32>,
+    /// Weld classes: vertices sewn together share a representative (empty: none welded).
+    rep: Vec<u32>,
 }
 
 impl SelfCollision {
@@ -104,7 +106,31 @@ impl SelfCollision {
             d_bp: Vec::new(),
             moved: Vec::new(),
             parent: Vec::new(),
+            rep: Vec::new(),
         }
+    }
+
+    /// Declares pairs of vertices sewn together (seams): a welded vertex counts as shared with
+    /// its partner, so the pair is never pushed apart nor counted as an intersection.
+    pub fn set_welds(&mut self, n: usize, pairs: &[(usize, usize)]) {
+        let mut rep: Vec<u32> = (0..n as u32).collect();
+        fn root(r: &mut [u32], mut a: u32) -> u32 {
+            while r[a as usize] != a {
+                r[a as usize] = r[r[a as usize] as usize];
+                a = r[a as usize];
+            }
+            a
+        }
+        for &(a, b) in pairs {
+            if a < n && b < n {
+                let (ra, rb) = (root(&mut rep, a as u32), root(&mut rep, b as u32));
+                rep[ra.max(rb) as usize] = ra.min(rb);
+            }
+        }
+        for i in 0..n as u32 {
+            rep[i as usize] = root(&mut rep, i);
+        }
+        self.rep = if pairs.is_empty() { Vec::new() } else { rep };
     }
 
     /// Which vertices the last [`SelfCollision::respond`] moved.
@@ -146,6 +172,8 @@ impl SelfCollision {
         self.edge_hash.build(&self.edge_boxes, self.cell);
         let (tris, edges) = (&self.triangles, &self.edges);
         let (tri_hash, edge_hash, edge_boxes) = (&self.tri_hash, &self.edge_hash, &self.edge_boxes);
+        let rep = &self.rep;
+        let r = |i: u32| if rep.is_empty() { i } else { rep[i as usize] };
         let n = x0.len();
         let chunk = 512;
         let vf: Vec<Vec<(u32, u32)>> = (0..n.div_ceil(chunk))
@@ -158,9 +186,10 @@ impl SelfCollision {
                     b.grow(&(x0[i] + d[i]));
                     tri_hash.query(&b, &mut buf);
                     let iu = i as u32;
+                    let ri = r(iu);
                     out.extend(
                         buf.iter()
-                            .filter(|&&t| !tris[t as usize].contains(&iu))
+                            .filter(|&&t| !tris[t as usize].iter().any(|&k| r(k) == ri))
                             .map(|&t| (iu, t)),
                     );
                 }
@@ -175,10 +204,12 @@ impl SelfCollision {
                 for e in c * chunk..((c + 1) * chunk).min(ne) {
                     edge_hash.query(&edge_boxes[e], &mut buf);
                     let [a, b] = edges[e];
+                    let (a, b) = (r(a), r(b));
                     out.extend(
                         buf.iter()
                             .filter(|&&f| {
                                 let [p, q] = edges[f as usize];
+                                let (p, q) = (r(p), r(q));
                                 f as usize > e && p != a && p != b && q != a && q != b
                             })
                             .map(|&f| (e as u32, f)),
@@ -526,6 +557,8 @@ impl SelfCollision {
             .extend(self.triangles.iter().map(|t| tight(t)));
         self.tri_hash.build(&self.tri_boxes, self.cell);
         let (tris, edges, hash) = (&self.triangles, &self.edges, &self.tri_hash);
+        let rep = &self.rep;
+        let r = |i: u32| if rep.is_empty() { i } else { rep[i as usize] };
         let ne = edges.len();
         let chunk = 1024;
         (0..ne.div_ceil(chunk))
@@ -538,7 +571,7 @@ impl SelfCollision {
                     hash.query(&tight(&[a, b]), &mut buf);
                     for &t in &buf {
                         let t = tris[t as usize];
-                        if t.contains(&a) || t.contains(&b) {
+                        if t.iter().any(|&k| r(k) == r(a) || r(k) == r(b)) {
                             continue;
                         }
                         let p = t.map(|i| x[i as usize]);

@@ -3,6 +3,9 @@
 //! mannequin and sewing into one cloth.
 
 pub mod body_frame;
+pub mod dress;
+pub mod dxf;
+pub mod dxf_write;
 pub mod error;
 pub mod expand;
 pub mod json;
@@ -15,11 +18,16 @@ pub mod shell;
 pub mod silhouette;
 pub mod svg;
 mod svg_path;
+mod svg_shape;
+mod svg_transform;
 pub mod table;
 pub mod validate;
 mod xml;
 
+pub use self::dxf::{parse_pattern_dxf, read_pattern_dxf};
 pub use body_frame::BodyFrame;
+pub use dress::{dress, DressParameters, DressReport, Dressed};
+pub use dxf_write::{pattern_to_dxf, write_pattern_dxf};
 pub use error::PatternError;
 pub use json::{read_pattern_json, write_pattern_json};
 pub use mesh::{mesh_pattern, GarmentMesh, MeshParameters, PieceMesh, SeamMesh};

@@ -1,0 +1,159 @@
+//! `dress`: the whole way from a pattern to a garment ready to be sewn on a mannequin. The
+//! pattern is meshed, pre-positioned around the body at rest, turned into a cloth model with
+//! a seam thread per pair of matching vertices and a sewing schedule, and put in a simulation
+//! with the body as a collision mesh and self-collision on (sewn vertices exempt). Stepping
+//! the simulation then sews (threads shorten, no gravity) and drapes.
+
+use std::time::Instant;
+
+use super::mesh::{mesh_pattern, GarmentMesh, MeshParameters};
+use super::preposition::{preposition, PrepositionParameters, PrepositionReport};
+use super::{BodyFrame, Pattern, PatternError, Silhouettes};
+use crate::body::Mannequin;
+use crate::cloth::{ClothModel, FabricParameters, Sewing, Simulation, SimulationParameters};
+use crate::contact::{Body, ContactSettings, MeshBody};
+
+/// Settings of [`dress`].
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
+pub struct DressParameters {
+    /// Meshing of the pieces.
+    pub mesh: MeshParameters,
+    /// Pre-positioning.
+    pub preposition: PrepositionParameters,
+    /// Stiffness of a seam thread (N/m).
+    pub seam_stiffness: f64,
+    /// How fast the seam threads shorten while sewing (m/s).
+    pub sewing_speed: f64,
+    /// Contact with the body and self-collision.
+    pub contact: ContactSettings,
+    /// Silhouette cell size (m).
+    pub silhouette_cell: f64,
+}
+
+impl Default for DressParameters {
+    fn default() -> Self {
+        DressParameters {
+            mesh: MeshParameters::default(),
+            preposition: PrepositionParameters::default(),
+            seam_stiffness: 300.0,
+            sewing_speed: 0.3,
+            contact: ContactSettings {
+                self_collision: true,
+                count_intersections: false,
+                ..Default::default()
+            },
+            silhouette_cell: 0.005,
+        }
+    }
+}
+
+/// Figures of a [`dress`] call.
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct DressReport {
+    /// Vertices and triangles of the garment mesh.
+    pub vertices: usize,
+    /// Triangles of the garment mesh.
+    pub triangles: usize,
+    /// Seam threads.
+    pub seam_pairs: usize,
+    /// Meshing time (s).
+    pub mesh_seconds: f64,
+    /// Body frame, silhouettes and landmarks (s).
+    pub body_seconds: f64,
+    /// Pre-positioning.
+    pub preposition: PrepositionReport,
+    /// When the last seam thread reaches rest length 0 (simulated s).
+    pub closing_time: f64,
+}
+
+/// A garment in its simulation, ready to be sewn and draped.
+#[derive(Debug)]
+pub struct Dressed {
+    /// The meshed garment (pieces, seams).
+    pub garment: GarmentMesh,
+    /// The simulation: the garment as cloth, the body, the sewing schedule.
+    pub simulation: Simulation,
+    /// What was done.
+    pub report: DressReport,
+}
+
+/// Meshes `pattern` (expanded and validated), pre-positions it around `mannequin` at rest and
+/// builds the simulation that sews and drapes it in `fabric`.
+pub fn dress(
+    pattern: &Pattern,
+    fabric: FabricParameters,
+    mannequin: &Mannequin,
+    params: &DressParameters,
+    sim_params: SimulationParameters,
+) -> Result<Dressed, PatternError> {
+    let bad = |name: &str, v: f64| {
+        PatternError::Parameter(format!("dress parameter `{name}` is invalid: {v}"))
+    };
+    if !(params.seam_stiffness.is_finite() && params.seam_stiffness > 0.0) {
+        return Err(bad("seam_stiffness", params.seam_stiffness));
+    }
+    if !(params.sewing_speed.is_finite() && params.sewing_speed > 0.0) {
+        return Err(bad("sewing_speed", params.sewing_speed));
+    }
+    params
+        .contact
+        .validate()
+        .map_err(|e| PatternError::Parameter(e.to_string()))?;
+    let t0 = Instant::now();
+    let garment = mesh_pattern(pattern, &params.mesh)?;
+    let t1 = Instant::now();
+    let frame = BodyFrame::of(mannequin.rest_positions(), mannequin.triangles())?;
+    let sil = Silhouettes::of(
+        frame,
+        mannequin.rest_positions(),
+        mannequin.triangles(),
+        params.silhouette_cell,
+    )?;
+    let marks = sil.landmarks()?;
+    let skin = MeshBody::new(
+        "mannequin",
+        mannequin.rest_positions().to_vec(),
+        mannequin.triangles(),
+    )
+    .map_err(|e| PatternError::Parameter(e.to_string()))?;
+    let t2 = Instant::now();
+    let (x, pre) = preposition(pattern, &garment, &sil, &marks, &skin, &params.preposition)?;
+    let mut mesh = garment.mesh.clone();
+    mesh.positions = x.clone();
+    let cloth_err = |e: crate::cloth::ClothError| PatternError::Parameter(e.to_string());
+    let mut model = ClothModel::from_mesh(mesh, fabric).map_err(cloth_err)?;
+    let pairs: Vec<(usize, usize)> = garment
+        .seams
+        .iter()
+        .flat_map(|s| s.pairs.iter().copied())
+        .filter(|(a, b)| a != b)
+        .collect();
+    let sewing = Sewing::add_to(
+        &mut model,
+        &pairs,
+        &x,
+        params.seam_stiffness,
+        params.sewing_speed,
+        sim_params.gravity,
+    );
+    let mut sim = Simulation::new(model, sim_params).map_err(cloth_err)?;
+    sim.contact.settings = params.contact;
+    sim.contact.bodies.push(Body::mesh(skin));
+    sim.contact.set_welds(x.len(), &pairs);
+    let report = DressReport {
+        vertices: x.len(),
+        triangles: garment.mesh.triangles.len(),
+        seam_pairs: pairs.len(),
+        mesh_seconds: (t1 - t0).as_secs_f64(),
+        body_seconds: (t2 - t1).as_secs_f64(),
+        preposition: pre,
+        closing_time: sewing.closing_time(),
+    };
+    sim.sewing = Some(sewing);
+    Ok(Dressed {
+        garment,
+        simulation: sim,
+        report,
+    })
+}
