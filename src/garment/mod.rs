@@ -20,6 +20,8 @@ pub mod svg;
 mod svg_path;
 mod svg_shape;
 mod svg_transform;
+mod svg_shape;
+mod svg_transform;
 pub mod table;
 pub mod validate;
 mod xml;
