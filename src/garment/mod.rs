@@ -20,8 +20,6 @@ pub mod svg;
 mod svg_path;
 mod svg_shape;
 mod svg_transform;
-mod svg_shape;
-mod svg_transform;
 pub mod table;
 pub mod validate;
 mod xml;
