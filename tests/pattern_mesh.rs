@@ -138,6 +138,21 @@ fn check(pattern: &Pattern, gm: &GarmentMesh, h: f64) -> Quality {
             assert_eq!(name, &c.name);
             assert_eq!(gm.flat[*v], c.at, "corner {name}");
         }
+        // the outline's corners under 60°
+        let b = &pm.boundary;
+        let sharp: Vec<(usize, f64)> = pm
+            .corners
+            .iter()
+            .map(|&(_, v)| {
+                let k = b.iter().position(|&x| x == v).unwrap();
+                let (p, n) = (b[(k + b.len() - 1) % b.len()], b[(k + 1) % b.len()]);
+                let (c, p, n) = (m.rest[v], m.rest[p], m.rest[n]);
+                let (u, w) = ([p[0] - c[0], p[1] - c[1]], [n[0] - c[0], n[1] - c[1]]);
+                let cos = (u[0] * w[0] + u[1] * w[1]) / (u[0].hypot(u[1]) * w[0].hypot(w[1]));
+                (v, cos.clamp(-1.0, 1.0).acos().to_degrees())
+            })
+            .filter(|&(_, alpha)| alpha < 60.0)
+            .collect();
         // triangles: in range, positive rest area; edges counted per direction
         let mut area = 0.0;
         let mut directed: BTreeMap<(usize, usize), usize> = BTreeMap::new();
@@ -158,6 +173,14 @@ fn check(pattern: &Pattern, gm: &GarmentMesh, h: f64) -> Quality {
                 q.min_angle = q.min_angle.min(angle);
                 if angle < 20.0 {
                     q.under_20 += 1;
+                    // only near a sharp corner (angle α) of the outline: the outline is
+                    // narrower than h up to about h / tan(α/2) from the tip
+                    let centre =
+                        [0, 1].map(|d| tri.iter().map(|&v| m.rest[v][d]).sum::<f64>() / 3.0);
+                    let near = sharp.iter().any(|&(v, alpha)| {
+                        dist(m.rest[v], centre) < h / (0.5 * alpha).to_radians().tan()
+                    });
+                    assert!(near, "{angle}° angle away from sharp corners");
                 }
             }
         }
@@ -175,7 +198,6 @@ fn check(pattern: &Pattern, gm: &GarmentMesh, h: f64) -> Quality {
             .filter(|(i, j)| !directed.contains_key(&(*j, *i)))
             .copied()
             .collect();
-        let b = &pm.boundary;
         let mut loop_edges: Vec<_> = (0..b.len()).map(|k| (b[k], b[(k + 1) % b.len()])).collect();
         open.sort();
         loop_edges.sort();
@@ -504,4 +526,56 @@ fn invalid_pieces_and_seams_are_named() {
     // clockwise outline
     let cw = polygon("cw", &[[0.0, 0.0], [0.0, 1.0], [1.0, 0.0]]);
     assert!(mesh_pattern(&pattern(vec![cw], vec![]), &h).is_err());
+}
+
+#[test]
+fn narrow_strips_gathered_seams_and_sharp_tips() {
+    let h = 0.01;
+    // strips 1.2 h and 2.5 h wide
+    for w in [0.012, 0.025] {
+        let pat = pattern(
+            vec![polygon(
+                "strip",
+                &[[0.0, 0.0], [0.5, 0.0], [0.5, w], [0.0, w]],
+            )],
+            vec![],
+        );
+        let gm = mesh_pattern(&pat, &params(h)).unwrap();
+        eprint!("strip {w}: ");
+        let q = check(&pat, &gm, h);
+        assert_quality(&q, h, 0);
+    }
+    // a ruffle: a 0.6 m edge gathered onto a 0.3 m edge (spacing h/2 on the short one)
+    let a = polygon("a", &[[0.0, 0.0], [0.3, 0.0], [0.3, 0.2], [0.0, 0.2]]);
+    let b = polygon("b", &[[0.0, 0.3], [0.6, 0.3], [0.6, 0.4], [0.0, 0.4]]);
+    let seam = Seam {
+        name: "gather".into(),
+        a: edge("a", "c2", "c3"),
+        b: edge("b", "c0", "c1"),
+        aligned: false,
+    };
+    let pat = pattern(vec![a, b], vec![seam]);
+    let gm = mesh_pattern(&pat, &params(h)).unwrap();
+    eprint!("gathered: ");
+    let q = check(&pat, &gm, h);
+    assert_quality(&q, h, 0);
+    assert_eq!(gm.seams[0].pairs.len(), 61);
+    // a 6° tip and a round piece of four cubics
+    let tip = polygon("tip", &[[0.0, 0.0], [0.05, 0.0], [0.025, 0.24]]);
+    let k = 0.5523 * 0.1;
+    let mut round = polygon("round", &[[0.1, 0.0], [0.0, 0.1], [-0.1, 0.0], [0.0, -0.1]]);
+    let ctrl = [
+        ([0.1, k], [k, 0.1]),
+        ([-k, 0.1], [-0.1, k]),
+        ([-0.1, -k], [-k, -0.1]),
+        ([k, -0.1], [0.1, -k]),
+    ];
+    for (c, (c1, c2)) in round.outline.corners.iter_mut().zip(ctrl) {
+        c.segment = Segment::Cubic { c1, c2 };
+    }
+    let pat = pattern(vec![tip, round], vec![]);
+    let gm = mesh_pattern(&pat, &params(h)).unwrap();
+    eprint!("tip and round: ");
+    let q = check(&pat, &gm, h);
+    assert_quality(&q, h, 6);
 }

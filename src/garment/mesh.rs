@@ -6,10 +6,12 @@
 //! [`GarmentMesh`]; the boundary sampling (seam edges at common arc-length fractions) lives in
 //! `mesh_boundary`. How a piece is meshed: its sampled outline, rotated so the grain line is
 //! +u, is the constraint loop of a constrained Delaunay triangulation (spade); the interior is
-//! seeded with a hexagonal lattice aligned with the warp, kept away from the boundary, smoothed
-//! (Laplacian, a few passes, each followed by a fresh triangulation) and finally refined for the
-//! minimum angle and the area with the boundary edges kept whole, so that the boundary vertices
-//! are exactly the sampled ones and seam pairs stay one to one.
+//! seeded with a hexagonal lattice aligned with the warp (rows along the grain), kept at least
+//! 0.6 edge length from the boundary; the lattice vertices near the boundary are smoothed
+//! (Laplacian, over the neighbours of a first triangulation) and the result triangulated
+//! again, then refined (spade's Delaunay refinement) for the minimum angle and the area with
+//! the constraint edges kept whole, so that the boundary vertices are exactly the sampled ones
+//! and seam pairs stay one to one.
 
 use std::ops::Range;
 
@@ -210,8 +212,8 @@ pub fn mesh_pattern(
 const LATTICE_CLEARANCE: f64 = 0.6;
 /// Smoothing keeps interior vertices at least this far (× edge length) from the boundary.
 const SMOOTH_CLEARANCE: f64 = 0.3;
-/// Laplacian smoothing passes.
-const SMOOTH_PASSES: usize = 4;
+/// Laplacian smoothing passes over the vertices near the boundary.
+const SMOOTH_PASSES: usize = 3;
 
 type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
@@ -225,10 +227,8 @@ fn triangulate(
     let nb = boundary.len();
     let grid = BoundaryGrid::new(boundary, h);
     let mut interior = lattice(boundary, h, &grid);
-    for _ in 0..SMOOTH_PASSES {
-        let cdt = build(boundary, &interior)?;
-        smooth(&cdt, nb, &mut interior, &grid, h);
-    }
+    let cdt = build(boundary, &interior)?;
+    smooth(&cdt, nb, &mut interior, &grid, h);
     let mut cdt = build(boundary, &interior)?;
     let ideal = 3f64.sqrt() / 4.0 * h * h;
     cdt.refine(
@@ -314,23 +314,43 @@ fn inside_faces(cdt: &Cdt) -> Vec<bool> {
     inside
 }
 
-/// One Laplacian pass over the interior vertices (Jacobi order), each move kept inside the
-/// disc free of boundary around the vertex and away from the boundary.
+/// Laplacian smoothing of the interior vertices near the boundary (closer than `h`), over the
+/// neighbours they have in `cdt` (Jacobi passes). Each move stays inside the disc
+/// free of boundary around the vertex and ends away from the boundary.
 fn smooth(cdt: &Cdt, nb: usize, interior: &mut [P2], grid: &BoundaryGrid, h: f64) {
-    let old = interior.to_vec();
-    for (k, p) in interior.iter_mut().enumerate() {
-        let v = cdt.vertex(FixedVertexHandle::from_index(nb + k));
-        let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
-        for e in v.out_edges() {
-            let q = e.to().position();
-            sx += q.x;
-            sy += q.y;
-            n += 1.0;
+    let band: Vec<(usize, Vec<usize>)> = (0..interior.len())
+        .filter(|&k| grid.distance(interior[k]) < h)
+        .map(|k| {
+            let v = cdt.vertex(FixedVertexHandle::from_index(nb + k));
+            (k, v.out_edges().map(|e| e.to().fix().index()).collect())
+        })
+        .collect();
+    let position = |interior: &[P2], i: usize| {
+        if i < nb {
+            let p = cdt.vertex(FixedVertexHandle::from_index(i)).position();
+            [p.x, p.y]
+        } else {
+            interior[i - nb]
         }
-        let q = [sx / n, sy / n];
-        let step = (q[0] - old[k][0]).hypot(q[1] - old[k][1]);
-        if step < grid.distance(old[k]) && grid.distance(q) >= SMOOTH_CLEARANCE * h {
-            *p = q;
+    };
+    let mut moved = Vec::with_capacity(band.len());
+    for _ in 0..SMOOTH_PASSES {
+        moved.clear();
+        for (k, ring) in &band {
+            let mut q = [0.0, 0.0];
+            for &i in ring {
+                let p = position(interior, i);
+                q = [q[0] + p[0], q[1] + p[1]];
+            }
+            let q = q.map(|c| c / ring.len() as f64);
+            let old = interior[*k];
+            let step = (q[0] - old[0]).hypot(q[1] - old[1]);
+            if step < grid.distance(old) && grid.distance(q) >= SMOOTH_CLEARANCE * h {
+                moved.push((*k, q));
+            }
+        }
+        for &(k, q) in &moved {
+            interior[k] = q;
         }
     }
 }
