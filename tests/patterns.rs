@@ -403,3 +403,69 @@ fn truncated_or_corrupted_files_give_errors_not_panics() {
         assert!(read_garment(&file).is_err());
     }
 }
+
+#[test]
+fn generic_svg_pieces_with_transforms_arcs_notches_and_allowance() {
+    // 1 user unit = 1 mm (width in cm over a viewBox of 10× the number). A 200 × 100 mm panel
+    // whose top edge is a half-disc (arc), drawn clockwise with relative commands inside a
+    // translated group; a 15 mm seam allowance path; a notch; a grain line drawn downwards.
+    let svg = r##"<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink"
+        width="30cm" height="30cm" viewBox="0 0 300 300">
+      <defs><g id="notch"><circle r="2"/></g></defs>
+      <g id="layer1">
+        <g id="panel" transform="translate(50 150)">
+          <path class="cutting" d="m 0,0 a 100,100 0 0 1 200,0 v 100 h -200 z"/>
+          <path class="sa" d="M -15,0 L -15,115 L 215,115 L 215,0"/>
+          <path class="grainline" d="M 100,80 L 100,20"/>
+          <use xlink:href="#notch" x="200" y="50"/>
+          <text>ignored</text>
+        </g>
+      </g>
+    </svg>"##;
+    let p = parse_pattern_svg(svg, Path::new("panel.svg"), &SvgOptions::default()).unwrap();
+    p.validate().unwrap();
+    assert_eq!(p.pieces.len(), 1);
+    let panel = &p.pieces[0];
+    assert_eq!(panel.name, "panel");
+    let area = 0.2 * 0.1 + std::f64::consts::PI * 0.1 * 0.1 / 2.0;
+    // Cubic quarter arcs bulge out by 0.027 % of the radius.
+    assert!(
+        (panel.outline.area() - area).abs() < 1e-5,
+        "{}",
+        panel.outline.area()
+    );
+    // Corners: the arc start (the path's start), the arc's 90° split point, its end, and the
+    // two bottom corners; c0 is the start point.
+    let o = &panel.outline;
+    assert_eq!(o.corners.len(), 5, "{:?}", o.corners);
+    assert_eq!(o.corners[0].name, "c0");
+    assert!((o.corners[0].at[0] - 0.05).abs() < 1e-12 && (o.corners[0].at[1] + 0.15).abs() < 1e-12);
+    let perimeter = o.edge_length(0, 0);
+    let expected = std::f64::consts::PI * 0.1 + 0.2 + 2.0 * 0.1;
+    assert!(
+        (perimeter - expected).abs() < 1e-4,
+        "{perimeter} vs {expected}"
+    );
+    assert!(
+        (panel.seam_allowance - 0.015).abs() < 1e-9,
+        "{}",
+        panel.seam_allowance
+    );
+    assert_eq!(panel.notches.len(), 1);
+    assert!(
+        (panel.notches[0][0] - 0.25).abs() < 1e-12 && (panel.notches[0][1] + 0.2).abs() < 1e-12
+    );
+    assert!(
+        panel.grain[1][1] > panel.grain[0][1],
+        "grain points up: {:?}",
+        panel.grain
+    );
+    assert!(panel.fold.is_none());
+    // The same drawing read at 1 unit = 1 cm is ten times larger.
+    let options = SvgOptions {
+        metres_per_unit: Some(0.01),
+        ..SvgOptions::default()
+    };
+    let big = parse_pattern_svg(svg, Path::new("panel.svg"), &options).unwrap();
+    assert!((big.pieces[0].outline.area() - 100.0 * area).abs() < 1e-3);
+}
