@@ -372,16 +372,20 @@ fn seam_between_straight_and_curved_edges_pairs_equal_fractions() {
 }
 
 #[test]
-fn seam_count_comes_from_the_longer_edge_and_corners_inside_an_edge_stay() {
-    // a's top runs c2 → c3 (0.4 m); b's bottom runs c0 → c1 → c2 (0.2 + 0.3 m), with a corner
-    let a = polygon("a", &[[0.0, 0.0], [0.4, 0.0], [0.4, 0.3], [0.0, 0.3]]);
+fn seam_count_comes_from_the_longer_edge_and_near_corners_meet() {
+    // a's top runs c2 → c3 → c4 (corner at half way); b's bottom runs c0 → c1 → c2, with its
+    // corner at 0.48 of its length from c0, i.e. 0.52 from a.from's end: the corners meet
+    let a = polygon(
+        "a",
+        &[[0.0, 0.0], [0.4, 0.0], [0.4, 0.3], [0.2, 0.31], [0.0, 0.3]],
+    );
     let b = polygon(
         "b",
-        &[[0.0, 0.5], [0.2, 0.45], [0.5, 0.5], [0.5, 0.8], [0.0, 0.8]],
+        &[[0.0, 0.5], [0.24, 0.45], [0.5, 0.5], [0.5, 0.8], [0.0, 0.8]],
     );
     let seam = Seam {
         name: "s".into(),
-        a: edge("a", "c2", "c3"),
+        a: edge("a", "c2", "c4"),
         b: edge("b", "c0", "c2"),
         aligned: false,
     };
@@ -390,13 +394,10 @@ fn seam_count_comes_from_the_longer_edge_and_corners_inside_an_edge_stay() {
     let gm = mesh_pattern(&pat, &params(h)).unwrap();
     check(&pat, &gm, h);
     let pairs = &gm.seams[0].pairs;
-    let lb = dist([0.0, 0.5], [0.2, 0.45]) + dist([0.2, 0.45], [0.5, 0.5]);
+    let lb = dist([0.0, 0.5], [0.24, 0.45]) + dist([0.24, 0.45], [0.5, 0.5]);
     assert!(pairs.len() > (lb / h).round() as usize);
-    let b1 = gm.pieces[1].corners[1].1;
-    assert!(
-        pairs.iter().any(|p| p.1 == b1),
-        "b's middle corner is paired"
-    );
+    let (a3, b1) = (gm.pieces[0].corners[3].1, gm.pieces[1].corners[1].1);
+    assert!(pairs.contains(&(a3, b1)), "corner meets corner");
     let mut seen: Vec<usize> = pairs.iter().flat_map(|p| [p.0, p.1]).collect();
     seen.sort();
     seen.dedup();
@@ -578,4 +579,21 @@ fn narrow_strips_gathered_seams_and_sharp_tips() {
     eprint!("tip and round: ");
     let q = check(&pat, &gm, h);
     assert_quality(&q, h, 6);
+}
+
+#[test]
+fn freesewing_garments_mesh_cleanly() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/patterns");
+    for name in ["aaron", "paco", "penelope"] {
+        let pat = emilion::garment::read_garment(dir.join(format!("{name}.garment.json")))
+            .unwrap()
+            .expanded()
+            .unwrap();
+        let h = 0.02;
+        let gm = mesh_pattern(&pat, &params(h)).unwrap();
+        eprint!("{name}: ");
+        let q = check(&pat, &gm, h);
+        assert_quality(&q, h, 0);
+        assert_eq!(gm.seams.len(), pat.seams.len());
+    }
 }

@@ -1,6 +1,7 @@
 //! Boundary sampling for meshing ([`super::mesh`]): the outline of every piece cut into boundary
 //! vertices at the target edge length, with the two edges of each seam sampled at the same
-//! arc-length fractions so that their vertices pair one to one.
+//! arc-length fractions (corner to corner where both edges have corners at nearly the same
+//! place) so that their vertices pair one to one.
 //!
 //! Owns its own Bézier evaluation and arc-length parameterisation (dense chord tables), the
 //! planning of seam fractions, and the check that a sampled outline is a simple polygon.
@@ -10,7 +11,7 @@ use super::pattern::{Pattern, Piece, Segment, P2};
 
 /// Chords per cubic in the arc-length table.
 const TABLE: usize = 512;
-/// Two edge fractions closer than this (relative to the edge length) are the same point.
+/// A fraction this close (relative to the edge length) to a corner is that corner.
 const SAME: f64 = 1e-9;
 
 /// One outline segment with an arc-length parameterisation.
@@ -164,8 +165,8 @@ fn corner_index(piece: &Piece, name: &str) -> Option<usize> {
     piece.outline.corners.iter().position(|c| c.name == name)
 }
 
-/// Samples every piece's outline at edge length `h`, seams first (same fractions on both
-/// edges), the remaining segments uniformly; checks each loop is a simple CCW polygon.
+/// Samples every piece's outline at edge length `h`, seams first (see [`seam_fractions`]),
+/// the remaining segments uniformly; checks each loop is a simple CCW polygon.
 pub(super) fn plan(pattern: &Pattern, curves: &[Vec<Curve>], h: f64) -> Result<Plan, PatternError> {
     let src = source_name(pattern);
     let seam_err = |seam: &str, message: String| PatternError::Seam {
@@ -228,23 +229,16 @@ pub(super) fn plan(pattern: &Pattern, curves: &[Vec<Curve>], h: f64) -> Result<P
         let (b, a) = (paths.pop().unwrap(), paths.pop().unwrap());
         // b's fraction g meets a's fraction f = g (aligned) or 1 - g
         let to_a = |g: f64| if seam.aligned { g } else { 1.0 - g };
-        let mut fixed: Vec<f64> = [0.0, 1.0].into_iter().chain(a.corner_fractions()).collect();
-        fixed.extend(b.corner_fractions().map(to_a));
-        fixed.sort_by(f64::total_cmp);
-        fixed.dedup_by(|x, y| (*x - *y).abs() <= SAME);
-        let longest = a.length().max(b.length());
-        let mut fractions = vec![0.0];
-        for w in fixed.windows(2) {
-            let mut k = ((w[1] - w[0]) * longest / h).round().max(1.0) as usize;
-            if fixed.len() == 2 {
-                k = k.max(2);
-            }
-            fractions.extend((1..k).map(|i| w[0] + (w[1] - w[0]) * i as f64 / k as f64));
-            fractions.push(w[1]);
-        }
-        for &f in &fractions {
-            for (path, g) in [(&a, f), (&b, to_a(f))] {
-                if let Loc::On(j, s) = path.locate(g, curves[path.piece].len()) {
+        let fractions = seam_fractions(
+            a.corner_fractions().collect(),
+            b.corner_fractions().map(to_a).collect(),
+            a.length(),
+            b.length(),
+            h,
+        );
+        for &(f, g) in &fractions {
+            for (path, x) in [(&a, f), (&b, to_a(g))] {
+                if let Loc::On(j, s) = path.locate(x, curves[path.piece].len()) {
                     inner[path.piece][j].push(s);
                 }
             }
@@ -292,11 +286,58 @@ pub(super) fn plan(pattern: &Pattern, curves: &[Vec<Curve>], h: f64) -> Result<P
             pieces: (a.piece, b.piece),
             pairs: fractions
                 .iter()
-                .map(|&f| (index(a, f), index(b, if *aligned { f } else { 1.0 - f })))
+                .map(|&(f, g)| (index(a, f), index(b, if *aligned { g } else { 1.0 - g })))
                 .collect(),
         })
         .collect();
     Ok(Plan { boundaries, seams })
+}
+
+/// The vertices of a seam as pairs of fractions (on edge a, on edge b measured in a's
+/// direction), from (0, 0) to (1, 1), given the fractions of the corners inside each edge.
+///
+/// Every corner is a vertex on its own edge; it meets the point at the same fraction on the
+/// other edge, unless a corner of the other edge lies within half an edge length (arc length)
+/// of it: then the two corners meet each other, so that matching corners drawn at slightly
+/// different fractions do not leave a sliver. Between these fixed pairs, both edges are cut
+/// into the same number of pieces (from the longer side and `h`), at equal fractions of the
+/// span; with no corners inside, this is equal arc-length fractions over the whole seam.
+fn seam_fractions(ca: Vec<f64>, cb: Vec<f64>, la: f64, lb: f64, h: f64) -> Vec<(f64, f64)> {
+    let mut marks: Vec<(f64, bool)> = ca.into_iter().map(|f| (f, true)).collect();
+    marks.extend(cb.into_iter().map(|g| (g, false)));
+    marks.sort_by(|x, y| x.0.total_cmp(&y.0).then(y.1.cmp(&x.1)));
+    let tol = 0.5 * h / la.max(lb);
+    let mut fixed = vec![(0.0, 0.0)];
+    let mut i = 0;
+    while i < marks.len() {
+        let (x, on_a) = marks[i];
+        match marks.get(i + 1) {
+            Some(&(y, next_on_a)) if next_on_a != on_a && y - x < tol => {
+                fixed.push(if on_a { (x, y) } else { (y, x) });
+                i += 2;
+            }
+            _ => {
+                fixed.push((x, x));
+                i += 1;
+            }
+        }
+    }
+    fixed.push((1.0, 1.0));
+    let mut out = vec![(0.0, 0.0)];
+    for w in fixed.windows(2) {
+        let ((f0, g0), (f1, g1)) = (w[0], w[1]);
+        let span = ((f1 - f0) * la).max((g1 - g0) * lb);
+        let mut k = (span / h).round().max(1.0) as usize;
+        if fixed.len() == 2 {
+            k = k.max(2);
+        }
+        out.extend((1..k).map(|i| {
+            let t = i as f64 / k as f64;
+            (f0 + (f1 - f0) * t, g0 + (g1 - g0) * t)
+        }));
+        out.push((f1, g1));
+    }
+    out
 }
 
 /// Twice the signed area of a closed polygon (shoelace).
