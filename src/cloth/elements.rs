@@ -18,11 +18,13 @@ pub enum SpringKind {
     /// Shear, measured through the stretch of a quad diagonal: γ = 2ε.
     Shear,
     /// A sewing thread between two pieces: a linear spring of `stiffness` (N/m) that pulls
-    /// when longer than its rest length (which may be 0) and is slack when shorter. Not a
-    /// fabric law: `area` is unused.
+    /// when longer than its rest length (which may be 0), at most with `max_force` (N), and is
+    /// slack when shorter. Not a fabric law: `area` is unused.
     Seam {
         /// Stiffness (N/m).
         stiffness: f64,
+        /// Largest pull (N): a thread drawing pieces together from far never yanks them.
+        max_force: f64,
     },
 }
 
@@ -64,13 +66,18 @@ impl Spring {
         let d = xb - xa;
         let len = d.norm();
         let dir = if len > 0.0 { d / len } else { Vec3::zeros() };
-        if let SpringKind::Seam { stiffness } = self.kind {
+        if let SpringKind::Seam {
+            stiffness,
+            max_force,
+        } = self.kind
+        {
             let stretch = (len - self.rest).max(0.0);
-            let tension = stiffness * stretch;
+            let tension = (stiffness * stretch).min(max_force);
+            let pulling = stretch > 0.0 && tension < max_force;
             return SpringEval {
                 dir,
                 tension,
-                axial: if stretch > 0.0 { stiffness } else { 0.0 },
+                axial: if pulling { stiffness } else { 0.0 },
                 transverse: if len > 0.0 { tension / len } else { 0.0 },
                 energy: 0.5 * stiffness * stretch * stretch,
             };

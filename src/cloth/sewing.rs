@@ -30,13 +30,14 @@ pub struct Sewing {
 }
 
 impl Sewing {
-    /// Adds a seam spring of `stiffness` (N/m) between each pair of particles at positions `x`,
-    /// with the pair's present distance as its first rest length.
+    /// Adds a seam spring of `stiffness` (N/m), pulling at most with `max_force` (N), between
+    /// each pair of particles at positions `x`, with the pair's present distance as its first
+    /// rest length.
     pub fn add_to(
         model: &mut ClothModel,
         pairs: &[(usize, usize)],
         x: &[Vec3],
-        stiffness: f64,
+        (stiffness, max_force): (f64, f64),
         speed: f64,
         gravity: [f64; 3],
     ) -> Sewing {
@@ -50,7 +51,10 @@ impl Sewing {
                 b,
                 rest: gap,
                 area: 0.0,
-                kind: SpringKind::Seam { stiffness },
+                kind: SpringKind::Seam {
+                    stiffness,
+                    max_force,
+                },
             });
         }
         Sewing {

@@ -23,6 +23,8 @@ pub struct DressParameters {
     pub preposition: PrepositionParameters,
     /// Stiffness of a seam thread (N/m).
     pub seam_stiffness: f64,
+    /// Largest pull of a seam thread (N).
+    pub seam_max_force: f64,
     /// How fast the seam threads shorten while sewing (m/s).
     pub sewing_speed: f64,
     /// Contact with the body and self-collision.
@@ -37,6 +39,7 @@ impl Default for DressParameters {
             mesh: MeshParameters::default(),
             preposition: PrepositionParameters::default(),
             seam_stiffness: 300.0,
+            seam_max_force: 0.3,
             sewing_speed: 0.3,
             contact: ContactSettings {
                 self_collision: true,
@@ -93,6 +96,9 @@ pub fn dress(
     if !(params.seam_stiffness.is_finite() && params.seam_stiffness > 0.0) {
         return Err(bad("seam_stiffness", params.seam_stiffness));
     }
+    if !(params.seam_max_force.is_finite() && params.seam_max_force > 0.0) {
+        return Err(bad("seam_max_force", params.seam_max_force));
+    }
     if !(params.sewing_speed.is_finite() && params.sewing_speed > 0.0) {
         return Err(bad("sewing_speed", params.sewing_speed));
     }
@@ -133,7 +139,7 @@ pub fn dress(
         &mut model,
         &pairs,
         &x,
-        params.seam_stiffness,
+        (params.seam_stiffness, params.seam_max_force),
         params.sewing_speed,
         sim_params.gravity,
     );

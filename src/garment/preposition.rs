@@ -90,11 +90,32 @@ struct Interval {
 /// A group's shell and the arc positions of its front and back centres.
 struct Group {
     shell: Shell,
+    /// Widening factor of the shell (≥ 1).
+    k: f64,
+    /// Left coordinates of the front and back centres.
+    centre_s: [f64; 2],
     front_arc: f64,
     front_c: f64,
     back_arc: f64,
     back_c: f64,
 }
+
+impl Group {
+    /// Widens the shell by `k` and finds the arc positions of the centres on it.
+    fn finish(&mut self, k: f64) {
+        self.k = k;
+        if k > 1.0 {
+            self.shell = self.shell.scaled(k);
+        }
+        self.front_arc = self.shell.arc_at(self.centre_s[0], true);
+        self.back_arc = self.shell.arc_at(self.centre_s[1], false);
+    }
+}
+
+/// Largest change of a shell's widening factor per metre of height: the shell narrows or
+/// widens gradually, so that vertical edges are not sheared where the garment's width changes
+/// fast (an armhole).
+const WIDENING_RATE: f64 = 0.4;
 
 struct Row {
     intervals: Vec<Interval>,
@@ -135,9 +156,49 @@ pub fn preposition(
         sil.row(ymin).saturating_sub(1),
         (sil.row(ymax) + 1).min(sil.nh - 1),
     );
-    let rows: Vec<Row> = (r0..=r1)
+    let mut rows: Vec<Row> = (r0..=r1)
         .map(|i| build_row(i, garment, &figs, &fig_pos, sil, marks, dz))
         .collect();
+    // above the lower chest (where armholes open the ring) the widening factor of one-group rows
+    // may only fall gradually going up: the shell does not shrink where the garment's width
+    // drops fast along an armhole, and the seams below, where the ring closes, still meet
+    let step = WIDENING_RATE * sil.cell;
+    let from = marks.waist + 0.25 * (marks.armpit - marks.waist);
+    let mut k: Vec<Option<f64>> = rows
+        .iter()
+        .map(|r| (r.groups.len() == 1).then(|| r.groups[0].k))
+        .collect();
+    for i in 1..k.len() {
+        if sil.h_of(r0 + i) < from {
+            continue;
+        }
+        if let (Some(a), Some(b)) = (k[i - 1], k[i]) {
+            k[i] = Some(b.max(a - step));
+        }
+    }
+    for (row, ki) in rows.iter_mut().zip(&k) {
+        for g in row.groups.iter_mut() {
+            let f = ki.unwrap_or(g.k);
+            g.finish(f);
+        }
+    }
+    let tops = column_tops(sil, marks);
+    if std::env::var("EMILION_DEBUG_PREPOSITION").is_ok() {
+        for (k, pm) in garment.pieces.iter().enumerate() {
+            let top = pm
+                .vertices
+                .clone()
+                .max_by(|&a, &b| fig_pos[a][1].total_cmp(&fig_pos[b][1]));
+            if let Some(v) = top {
+                let [fx, fy] = fig_pos[v];
+                let j = sil.col(s_of(figs[k].side, fx));
+                eprintln!(
+                    "piece {}: top at X {fx:.3} h {fy:.3}; column top {:?}; shoulder {:.3} neck {:.3}",
+                    pm.name, tops[j].map(|i| sil.h_of(i)), marks.shoulder, marks.neck
+                );
+            }
+        }
+    }
     let mut x = vec![Vec3::zeros(); n];
     for v in 0..n {
         let [fx, fy] = fig_pos[v];
@@ -166,7 +227,8 @@ pub fn preposition(
                 (p[0], p[1])
             }
         };
-        x[v] = sil.frame.to_world(s, fy, d);
+        let (h, d) = over_the_top(sil, marks, &tops, figs[k].side, s, fy, d, dz);
+        x[v] = sil.frame.to_world(s, h, d);
     }
     // push out what the shells did not keep clear (between rows, sharp features)
     let mut report = PrepositionReport {
@@ -192,10 +254,81 @@ pub fn preposition(
         }
     }
     let (mean, max) = edge_strain(garment, &x);
+    if std::env::var("EMILION_DEBUG_PREPOSITION").is_ok() {
+        let m = &garment.mesh;
+        let mut worst: Vec<(f64, usize, usize)> = Vec::new();
+        for t in &m.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let r = (m.rest[a][0] - m.rest[b][0]).hypot(m.rest[a][1] - m.rest[b][1]);
+                worst.push(((x[a] - x[b]).norm() / r - 1.0, a, b));
+            }
+        }
+        worst.sort_by(|p, q| q.0.total_cmp(&p.0));
+        let over: usize = worst.iter().filter(|w| w.0 > 0.3).count();
+        eprintln!("edges over 30 %: {over} of {}", worst.len());
+        for w in worst.iter().step_by(10).take(12) {
+            let b = sil.frame.to_body(&x[w.1]);
+            eprintln!(
+                "strain {:.2} at fig {:?} piece {} body s {:.3} h {:.3} d {:.3}",
+                w.0, fig_pos[w.1], piece_of[w.1], b[0], b[1], b[2]
+            );
+        }
+    }
     report.mean_strain = mean;
     report.max_strain = max;
     report.seconds = start.elapsed().as_secs_f64();
     Ok((x, report))
+}
+
+/// Per silhouette column, the highest covered row no higher than the neck (the top of the
+/// shoulder under a strap), or `None` for an empty column.
+fn column_tops(sil: &Silhouettes, marks: &Landmarks) -> Vec<Option<usize>> {
+    let cap = sil.row(marks.neck);
+    (0..sil.ns)
+        .map(|j| (0..=cap).rev().find(|&i| sil.covered(i, j)))
+        .collect()
+}
+
+/// A vertex of the figurine that rises above the body's top at its column (a strap above the
+/// shoulder) is laid over the top instead, front pieces towards the back and back pieces
+/// towards the front, up to a fin just off the body's mid-depth where the two meet (the seed's
+/// 3D silhouette): returns its height and depth.
+#[allow(clippy::too_many_arguments)]
+fn over_the_top(
+    sil: &Silhouettes,
+    marks: &Landmarks,
+    tops: &[Option<usize>],
+    side: Side,
+    s: f64,
+    y: f64,
+    d: f64,
+    dz: f64,
+) -> (f64, f64) {
+    let j = sil.col(s);
+    let Some(i) = tops[j] else {
+        return (y, d);
+    };
+    let top = sil.h_of(i).min(marks.neck) + dz;
+    if y <= top {
+        return (y, d);
+    }
+    let Some((f, b)) = sil.depths(i, j) else {
+        return (y, d);
+    };
+    let e = y - top;
+    let fin = 0.5 * dz;
+    let mid = 0.5 * (f + b);
+    match side {
+        Side::Front => {
+            let room = (d - mid - fin).max(0.0);
+            (top + (e - room).max(0.0), d - e.min(room))
+        }
+        Side::Back => {
+            let room = (mid - fin - d).max(0.0);
+            (top + (e - room).max(0.0), d + e.min(room))
+        }
+    }
 }
 
 /// Mean and largest |L/L0 − 1| over the garment's edges at positions `x`.
@@ -309,7 +442,8 @@ fn gap(iv: &Interval, x: f64) -> f64 {
     (iv.x0 - x).max(x - iv.x1).max(0.0)
 }
 
-/// The intervals, groups and shells of one silhouette row.
+/// The intervals, groups and (unwidened) shells of one silhouette row; each group's widening
+/// factor is the garment row's length over the shell's perimeter when above 1.
 fn build_row(
     i: usize,
     garment: &GarmentMesh,
@@ -401,7 +535,10 @@ fn build_row(
         }
         let mut joined = false;
         for (k, sec) in sections.iter().enumerate() {
-            if a0 < sec.1 && sec.0 < a1 {
+            // a section joins when the interval covers its middle: an arm hanging beside a
+            // shirt's side does not widen the shirt's shell
+            let mid = 0.5 * (sec.0 + sec.1);
+            if a0 <= mid && mid <= a1 {
                 let (ra, rb) = (find(&mut parent, a), find(&mut parent, ni + k));
                 parent[ra] = rb;
                 joined = true;
@@ -449,11 +586,11 @@ fn build_row(
                     pts.extend([[a, 0.05], [b, 0.05], [a, -0.05], [b, -0.05]]);
                 }
             }
-            let mut shell = Shell::around(&pts, dz).expect("a section has points");
+            let Some(shell) = Shell::around(&pts, dz) else {
+                unreachable_shell()
+            };
             let width: f64 = members.iter().map(|iv| iv.x1 - iv.x0).sum();
-            if width > shell.perimeter() {
-                shell = shell.scaled(width / shell.perimeter());
-            }
+            let k = (width / shell.perimeter()).max(1.0);
             let centre = |side: Side| {
                 let (lo, hi) = members
                     .iter()
@@ -469,13 +606,20 @@ fn build_row(
             let fc_s = fc.or(bc.map(|b| -b)).unwrap_or(0.0);
             let bc_s = bc.map(|b| -b).unwrap_or(fc_s);
             Group {
-                front_arc: shell.arc_at(fc_s, true),
-                back_arc: shell.arc_at(bc_s, false),
+                shell,
+                k,
+                centre_s: [fc_s, bc_s],
+                front_arc: 0.0,
+                back_arc: 0.0,
                 front_c: fc.unwrap_or(fc_s),
                 back_c: bc.unwrap_or(-bc_s),
-                shell,
             }
         })
         .collect();
     Row { intervals, groups }
+}
+
+/// A shell grown from at least one point always exists (24 points round it).
+fn unreachable_shell() -> ! {
+    unreachable!("a grown shell of a non-empty section has 24 points or more")
 }
