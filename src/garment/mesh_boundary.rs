@@ -442,3 +442,37 @@ fn check_simple(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn arc_length_of_a_straight_cubic_is_its_chord() {
+        let c = Curve::new(
+            [0.0, 0.0],
+            &Segment::Cubic {
+                c1: [0.1, 0.0],
+                c2: [0.2, 0.0],
+            },
+            [0.3, 0.0],
+        );
+        assert!((c.length - 0.3).abs() < 1e-12);
+        let p = c.point_at(0.1);
+        assert!((p[0] - 0.1).abs() < 1e-9 && p[1] == 0.0);
+    }
+
+    #[test]
+    fn seam_fractions_are_uniform_without_corners_and_merge_near_corners() {
+        let f = seam_fractions(vec![], vec![], 1.0, 0.8, 0.1);
+        assert_eq!(f.len(), 11);
+        assert!(f.iter().all(|&(a, b)| a == b));
+        // a corner at 0.5 on a, one at 0.52 on b (a's direction): they meet
+        let f = seam_fractions(vec![0.5], vec![0.52], 1.0, 1.0, 0.1);
+        assert!(f.contains(&(0.5, 0.52)));
+        // far apart: each meets a plain point of the other edge
+        let f = seam_fractions(vec![0.3], vec![0.6], 1.0, 1.0, 0.1);
+        assert!(f.contains(&(0.3, 0.3)) && f.contains(&(0.6, 0.6)));
+        assert!(f.windows(2).all(|w| w[1].0 > w[0].0 && w[1].1 > w[0].1));
+    }
+}
