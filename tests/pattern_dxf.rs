@@ -385,6 +385,15 @@ fn inline_faults() {
     let nan = flat_dxf("", &square("1", 2.0, 2.0).replace("10\n2\n", "10\nnan\n"));
     let e = parse(&nan).unwrap_err();
     assert!(e.to_string().contains("not a finite number"), "{e}");
+    // In a piece block, the piece is named; a number the crate would drop silently is caught.
+    let yoke = std::fs::read_to_string(data("open_boundary.dxf")).unwrap();
+    for bad in ["nan", "1x.0", "inf"] {
+        let s = parse(&yoke.replacen(" 10\n6\n", &format!(" 10\n{bad}\n"), 1))
+            .unwrap_err()
+            .to_string();
+        assert!(s.contains("'YOKE'") && s.contains("not a finite number"), "{s}");
+        assert!(s.contains("line 60:"), "{s}");
+    }
     let spline = flat_dxf(
         "",
         &(square("1", 2.0, 2.0) + "0\nSPLINE\n8\n14\n70\n8\n71\n3\n"),
@@ -421,7 +430,12 @@ fn damaged_files_never_panic() {
         seed ^= seed << 17;
         seed
     };
-    for _ in 0..400 {
+    // DXF_FUZZ_ROUNDS=100000 for a longer run.
+    let rounds = std::env::var("DXF_FUZZ_ROUNDS")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(400);
+    for _ in 0..rounds {
         let mut bad = good.clone();
         for _ in 0..1 + next() % 4 {
             let i = (next() % bad.len() as u64) as usize;
@@ -434,5 +448,30 @@ fn damaged_files_never_panic() {
         }
         record(parse_pattern_dxf(&bad, name));
     }
+    // Binary DXF sentinel followed by noise.
+    for _ in 0..rounds / 4 {
+        let mut bad = b"AutoCAD Binary DXF\r\n\x1a\0".to_vec();
+        bad.extend((0..next() % 600).map(|_| (next() % 256) as u8));
+        record(parse_pattern_dxf(&bad, name));
+    }
     assert!(outcomes[0] > 0 && outcomes[1] > 0, "{outcomes:?}");
+}
+
+#[test]
+fn binary_dxf_reads_like_ascii() {
+    let ascii = read_pattern_dxf(&data("shirt_aama.dxf")).unwrap();
+    let drawing = dxf::Drawing::load_file(data("shirt_aama.dxf")).unwrap();
+    let path = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("shirt_binary.dxf");
+    drawing.save_file_binary(&path).unwrap();
+    let binary = read_pattern_dxf(&path).unwrap();
+    assert_eq!(ascii.pieces.len(), binary.pieces.len());
+    for (a, b) in ascii.pieces.iter().zip(&binary.pieces) {
+        assert_eq!(a.name, b.name);
+        assert!(outline_gap(&a.outline, &b.outline) < 1e-9, "{}", a.name);
+        assert_eq!(
+            (&a.fold, a.copies, a.notches.len()),
+            (&b.fold, b.copies, b.notches.len())
+        );
+        assert!((a.seam_allowance - b.seam_allowance).abs() < 1e-9);
+    }
 }

@@ -271,7 +271,7 @@ fn fit_cubic(q: &[P2]) -> Option<([P2; 4], f64)> {
             r2 = add(r2, mul(rest, b2));
         }
         let det = a11 * a22 - a12 * a12;
-        if !(det > 1e-12 * (a11 + a22).powi(2)) {
+        if det.is_nan() || det <= 1e-12 * (a11 + a22).powi(2) {
             return None;
         }
         let c1 = mul(sub(mul(r1, a22), mul(r2, a12)), 1.0 / det);

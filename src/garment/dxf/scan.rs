@@ -87,8 +87,11 @@ fn shorten(s: &str) -> String {
     t
 }
 
-/// Scans `data`; `Ok(None)` for a binary file. Errors carry the 1-based line.
-pub(crate) fn scan(data: &[u8]) -> Result<Option<Scan>, (usize, String)> {
+/// A fault found by the scan: 1-based line, what is wrong, and the block it is in.
+pub(crate) type Fault = (usize, String, Option<String>);
+
+/// Scans `data`; `Ok(None)` for a binary file.
+pub(crate) fn scan(data: &[u8]) -> Result<Option<Scan>, Fault> {
     if data.starts_with(b"AutoCAD Binary DXF") || data.starts_with(b"AutoCAD DXB") {
         return Ok(None);
     }
@@ -108,22 +111,26 @@ pub(crate) fn scan(data: &[u8]) -> Result<Option<Scan>, (usize, String)> {
             Err(_) if lines[i].is_empty() && lines[i + 1..].iter().all(|l| l.is_empty()) => break,
             Err(_) => {
                 let found = shorten(lines[i]);
-                return Err((code_line, format!("expected a group code, found '{found}'")));
+                let msg = format!("expected a group code, found '{found}'");
+                let here = block.clone().filter(|b| !b.is_empty());
+                return Err((code_line, msg, here));
             }
         };
         i += 2;
+        let in_blocks = section.as_deref() == Some("BLOCKS");
+        let here = || block.clone().filter(|b| in_blocks && !b.is_empty());
         if is_float_code(code) {
             match value.parse::<f64>() {
                 Ok(v) if v.is_finite() => {}
                 _ => {
                     let found = shorten(value);
                     let msg = format!("group code {code}: '{found}' is not a finite number");
-                    return Err((code_line + 1, msg));
+                    return Err((code_line + 1, msg, here()));
                 }
             }
         } else if is_int_code(code) && value.parse::<i64>().is_err() {
             let msg = format!("group code {code}: '{}' is not an integer", shorten(value));
-            return Err((code_line + 1, msg));
+            return Err((code_line + 1, msg, here()));
         }
         match code {
             0 => {
