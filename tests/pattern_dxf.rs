@@ -391,7 +391,10 @@ fn inline_faults() {
         let s = parse(&yoke.replacen(" 10\n6\n", &format!(" 10\n{bad}\n"), 1))
             .unwrap_err()
             .to_string();
-        assert!(s.contains("'YOKE'") && s.contains("not a finite number"), "{s}");
+        assert!(
+            s.contains("'YOKE'") && s.contains("not a finite number"),
+            "{s}"
+        );
         assert!(s.contains("line 60:"), "{s}");
     }
     let spline = flat_dxf(
