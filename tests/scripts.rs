@@ -104,6 +104,7 @@ fn other_scripts_run() {
             "drape_table",
             "self_fold",
             "mannequin_walk",
+            "aaron",
         ]
         .contains(&name.as_str())
         {

@@ -16,6 +16,7 @@ pub mod contact;
 pub mod convert;
 pub mod docs;
 pub mod fabric;
+pub mod garment;
 pub mod kes;
 pub mod output;
 pub mod repl;
@@ -104,6 +105,7 @@ pub fn build_engine_with(limits: EngineLimits) -> Engine {
     fabric::register(&mut engine);
     sim::register(&mut engine);
     contact::register(&mut engine);
+    garment::register(&mut engine);
     output::register(&mut engine);
     kes::register(&mut engine);
     engine

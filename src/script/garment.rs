@@ -1,0 +1,100 @@
+//! Script bindings for garments: pattern files (garment tables, JSON, SVG, DXF-AAMA) as a
+//! `Pattern` handle, and `dress`, which meshes, pre-positions and sews a pattern on the
+//! mannequin into a `Simulation`.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use rhai::{Engine, Map, INT};
+
+use super::convert::{num, rt_err, update_from_map, RResult};
+use super::{register, Fabric, SimHandle};
+use crate::body::Mannequin;
+use crate::cloth::SimulationParameters;
+use crate::garment::{dress, read_garment, read_pattern_json, read_pattern_svg, DressParameters};
+use crate::garment::{Pattern, PatternError, SvgOptions};
+
+/// A pattern as a script handle (shared, never copied).
+#[derive(Debug, Clone)]
+pub struct PatternHandle(pub Arc<Pattern>);
+
+fn perr(e: PatternError) -> Box<rhai::EvalAltResult> {
+    rt_err(e.to_string())
+}
+
+/// Reads a pattern by its file's extension.
+fn read_any(path: &str) -> Result<Pattern, PatternError> {
+    let p = Path::new(path);
+    if path.ends_with(".garment.json") {
+        read_garment(p)
+    } else if path.ends_with(".json") {
+        read_pattern_json(p)?.expanded()
+    } else if path.ends_with(".svg") {
+        read_pattern_svg(p, &SvgOptions::default())?.expanded()
+    } else if path.ends_with(".dxf") {
+        crate::garment::read_pattern_dxf(p)?.expanded()
+    } else {
+        Err(PatternError::Parameter(format!(
+            "{path}: unknown pattern format (expected .garment.json, .json, .svg or .dxf)"
+        )))
+    }
+}
+
+/// Registers the garment functions.
+pub fn register(engine: &mut Engine) {
+    engine.register_type_with_name::<PatternHandle>("Pattern");
+    register!(engine, "garment_pattern", ["path: String", "Pattern"],
+        "Reads a sewing pattern: a garment table (`*.garment.json`: an SVG, the parts used, folds,\npairs, placements and seams), a pattern in JSON, an SVG or a DXF-AAMA file. Pieces cut on the\nfold are unfolded and pairs doubled; the pattern is validated (closed, non-crossing outlines,\nmatching seam lengths) with errors naming file, piece and edge.",
+        |path: &str| -> RResult<PatternHandle> { Ok(PatternHandle(Arc::new(read_any(path).map_err(perr)?))) });
+    register!(
+        engine,
+        "piece_count",
+        ["pattern: Pattern", "int"],
+        "Number of pieces (after unfolding and doubling).",
+        |p: &mut PatternHandle| -> INT { p.0.pieces.len() as INT }
+    );
+    register!(
+        engine,
+        "seam_count",
+        ["pattern: Pattern", "int"],
+        "Number of seams.",
+        |p: &mut PatternHandle| -> INT { p.0.seams.len() as INT }
+    );
+    register!(engine, "dress", ["pattern: Pattern", "fabric: Fabric", "options: Map", "Simulation"],
+        "Meshes the pattern, pre-positions it around the MakeHuman mannequin at rest (no arrangement\npoints) and returns a simulation that sews it (seam threads shorten at `sewing_speed`, no\ngravity) and then drapes it, the mannequin as a collision body. Options: `makehuman` (dir,\ndefault `$EMILION_DATA/bodies/makehuman`), `dt` (s), and the `DressParameters` fields:\n`seam_stiffness` (N/m), `seam_max_force` (N), `sewing_speed` (m/s), `silhouette_cell` (m),\n`edge_length` (m, the mesh's target edge) and `clearance` (m, kept from the skin).",
+        |p: &mut PatternHandle, f: Fabric, mut m: Map| -> RResult<SimHandle> {
+            let dir = match m.remove("makehuman") {
+                Some(d) => d.into_string().map_err(|t| rt_err(format!("`makehuman` must be a string, got {t}")))?.into(),
+                None => std::env::var_os("EMILION_DATA")
+                    .map_or_else(|| "../shared/data".into(), std::path::PathBuf::from)
+                    .join("bodies/makehuman"),
+            };
+            let mut sp = SimulationParameters::default();
+            if let Some(dt) = m.remove("dt") {
+                sp.dt = num(&dt, "dt")?;
+            }
+            let mut params = DressParameters::default();
+            if let Some(e) = m.remove("edge_length") {
+                params.mesh.edge_length = num(&e, "edge_length")?;
+            }
+            if let Some(c) = m.remove("clearance") {
+                params.preposition.clearance = num(&c, "clearance")?;
+            }
+            let params: DressParameters = update_from_map(&params, &m, "dress")?;
+            let man = Mannequin::load_makehuman(&dir).map_err(|e| rt_err(e.to_string()))?;
+            let d = dress(&p.0, f.0, &man, &params, sp).map_err(perr)?;
+            Ok(SimHandle::new(d.simulation))
+        });
+    register!(
+        engine,
+        "seam_gap",
+        ["sim: Simulation", "float"],
+        "The largest distance between sewn vertices (m); 0 without seams.",
+        |h: &mut SimHandle| -> RResult<f64> {
+            let s = h.get()?;
+            Ok(s.sewing
+                .as_ref()
+                .map_or(0.0, |w| w.max_gap(&s.model, &s.state.x)))
+        }
+    );
+}
