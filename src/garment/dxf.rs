@@ -12,9 +12,10 @@
 //!   14 or a `Piece Name:` text. With no such block, the ENTITIES section is one piece; with
 //!   piece blocks, boundary geometry outside them is an error.
 //! - Piece system text (TEXT/MTEXT): `Piece Name: X` names the piece (else the block name);
-//!   `Quantity: N` gives [`Copies::Pair`] for even N ≥ 2, else [`Copies::One`]. Style system
-//!   text: `Style Name:` names the pattern (else the file stem); `Units: ENGLISH` (inches) or
-//!   `METRIC` (mm), also `CM`, `M`; without it `$INSUNITS`; without both, millimetres.
+//!   `Quantity: N` gives [`Copies::Pair`](super::Copies::Pair) for even N ≥ 2, else `One`.
+//!   Style system text: `Style Name:` names the pattern (else the file stem); `Units: ENGLISH`
+//!   (inches) or `METRIC` (mm), also `CM`, `M`; without it `$INSUNITS`; without both,
+//!   millimetres.
 //! - Layer 1 boundary (cut line), 14 sew line: LINE, POLYLINE, LWPOLYLINE (bulges), ARC and
 //!   CIRCLE, chained end to end within 0.01 mm into one closed loop each. The outline is the
 //!   sew line when there is one, else the boundary; the seam allowance is the mean distance
