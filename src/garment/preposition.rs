@@ -598,7 +598,7 @@ fn build_row(
                     .fold((f64::MAX, f64::MIN), |(l, h), iv| {
                         (l.min(iv.x0), h.max(iv.x1))
                     });
-                (lo <= hi).then(|| 0.5 * (lo + hi))
+                (lo <= hi).then_some(0.5 * (lo + hi))
             };
             let fc = centre(Side::Front);
             let bc = centre(Side::Back);
