@@ -59,8 +59,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .as_ref()
                 .map_or(0.0, |s| s.max_gap(&sim.model, &sim.state.x));
             println!(
-                "t {:.3} s: step {:.1} ms, cg {}, seam gap {:.2} mm, contacts {}, self {}, min distance {:.4}, penetrating {}",
-                sim.state.time, st.step_ms, st.cg_iterations, gap * 1e3, st.contacts, st.self_contacts, st.min_distance, st.penetrating
+                "t {:.3} s: step {:.1} ms (assemble {:.1}, solve {:.1}, collision {:.1}), cg {}, seam gap {:.2} mm, contacts {}, self {}, min distance {:.4}, penetrating {}",
+                sim.state.time, st.step_ms, st.assemble_ms, st.solve_ms, st.collision_ms, st.cg_iterations, gap * 1e3, st.contacts, st.self_contacts, st.min_distance, st.penetrating
             );
         }
     }

@@ -34,6 +34,8 @@ pub struct MeshBody {
     face_normals: Vec<Vec3>,
     vertex_normals: Vec<Vec3>,
     parry: ParryMesh,
+    /// Bounds of `positions`, kept up to date (asked once per cloth vertex and step).
+    aabb: (Vec3, Vec3),
     animation: Option<Arc<dyn BodyAnimation>>,
     scratch: Vec<Vec3>,
     /// Triangles dropped because they had no area.
@@ -149,12 +151,14 @@ impl MeshBody {
             triangles: tris,
             across,
             parry,
+            aabb: (Vec3::zeros(), Vec3::zeros()),
             animation: None,
             scratch: Vec::new(),
             dropped_degenerate: dropped,
             closed,
         };
         body.update_normals();
+        body.aabb = crate::geometry::mesh::bounds(&body.positions);
         Ok(body)
     }
 
@@ -209,6 +213,7 @@ impl MeshBody {
             }
         });
         self.update_normals();
+        self.aabb = crate::geometry::mesh::bounds(&self.positions);
     }
 
     /// Moves an animated mesh to its pose at time `t`, the last move lasting `dt`.
@@ -231,7 +236,7 @@ impl MeshBody {
 
     /// Axis-aligned bounds of the current vertices.
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        crate::geometry::mesh::bounds(&self.positions)
+        self.aabb
     }
 
     fn update_normals(&mut self) {

@@ -139,14 +139,24 @@ pub fn preposition(
             "pre-positioning clearance must be > 0, got {dz}"
         )));
     }
-    let figs = figurines(pattern, garment, marks)?;
+    let mut figs = figurines(pattern, garment, marks)?;
     let n = garment.mesh.positions.len();
     let mut fig_pos = vec![[0.0; 2]; n];
     let mut piece_of = vec![0usize; n];
-    for (k, pm) in garment.pieces.iter().enumerate() {
-        for v in pm.vertices.clone() {
-            fig_pos[v] = figs[k].apply(&garment.flat[v]);
-            piece_of[v] = k;
+    let tops = column_tops(sil, marks);
+    for pass in 0..2 {
+        for (k, pm) in garment.pieces.iter().enumerate() {
+            for v in pm.vertices.clone() {
+                fig_pos[v] = figs[k].apply(&garment.flat[v]);
+                piece_of[v] = k;
+            }
+        }
+        if pass == 0 {
+            let lifts =
+                over_the_top_lifts(garment, &figs, &fig_pos, &piece_of, sil, marks, &tops, dz);
+            for (f, l) in figs.iter_mut().zip(lifts) {
+                f.at[1] += l;
+            }
         }
     }
     let (ymin, ymax) = fig_pos
@@ -182,7 +192,6 @@ pub fn preposition(
             g.finish(f);
         }
     }
-    let tops = column_tops(sil, marks);
     if std::env::var("EMILION_DEBUG_PREPOSITION").is_ok() {
         for (k, pm) in garment.pieces.iter().enumerate() {
             let top = pm
@@ -279,6 +288,62 @@ pub fn preposition(
     report.max_strain = max;
     report.seconds = start.elapsed().as_secs_f64();
     Ok((x, report))
+}
+
+/// How far each piece must rise so that the seams joining a front piece to a back piece over
+/// the top of the body (shoulder seams) meet when both are laid over the top
+/// ([`over_the_top`]): for each such seam, half of what its two edges lack to cover the body's
+/// depth there; a piece takes the largest of its seams. Seams elsewhere (side seams, which the
+/// shells already close) ask for nothing.
+#[allow(clippy::too_many_arguments)]
+fn over_the_top_lifts(
+    garment: &GarmentMesh,
+    figs: &[Figurine],
+    fig_pos: &[P2],
+    piece_of: &[usize],
+    sil: &Silhouettes,
+    marks: &Landmarks,
+    tops: &[Option<usize>],
+    dz: f64,
+) -> Vec<f64> {
+    let mut lift = vec![0.0f64; figs.len()];
+    let fin = 0.5 * dz;
+    for seam in &garment.seams {
+        let (mut need, mut count) = (0.0, 0usize);
+        let mut pieces = None;
+        for &(a, b) in &seam.pairs {
+            let (pa, pb) = (piece_of[a], piece_of[b]);
+            if figs[pa].side == figs[pb].side {
+                continue;
+            }
+            let (f, bk) = if figs[pa].side == Side::Front {
+                (a, b)
+            } else {
+                (b, a)
+            };
+            let s = s_of(Side::Front, fig_pos[f][0]);
+            let j = sil.col(s);
+            let Some(i) = tops[j] else { continue };
+            let top = sil.h_of(i).min(marks.neck) + dz;
+            let (yf, yb) = (fig_pos[f][1], fig_pos[bk][1]);
+            // only seams that end near the top of the body, not side seams
+            if yf < top - 0.04 || yb < top - 0.04 {
+                continue;
+            }
+            let Some((df, db)) = sil.depths(i, j) else {
+                continue;
+            };
+            need += 0.5 * ((df - db) + 2.0 * dz - 2.0 * fin - (yf - top) - (yb - top));
+            count += 1;
+            pieces = Some((piece_of[f], piece_of[bk]));
+        }
+        if let (Some((pf, pb)), true) = (pieces, count > 0) {
+            let l = (need / count as f64).max(0.0);
+            lift[pf] = lift[pf].max(l);
+            lift[pb] = lift[pb].max(l);
+        }
+    }
+    lift
 }
 
 /// Per silhouette column, the highest covered row no higher than the neck (the top of the
