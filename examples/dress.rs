@@ -48,6 +48,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     let sim = &mut d.simulation;
+    let _ = &d.garment;
     let steps = sim.steps_for(seconds);
     let mut worst_inside = 0;
     for k in 0..steps {
@@ -63,6 +64,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 sim.state.time, st.step_ms, st.assemble_ms, st.solve_ms, st.collision_ms, st.cg_iterations, gap * 1e3, st.contacts, st.self_contacts, st.min_distance, st.penetrating
             );
         }
+    }
+    for s in &d.garment.seams {
+        let x = &sim.state.x;
+        let gaps: Vec<f64> = s.pairs.iter().map(|&(a, b)| (x[a] - x[b]).norm()).collect();
+        let worst = gaps.iter().cloned().enumerate().fold((0, 0.0), |w, (i, g)| if g > w.1 { (i, g) } else { w });
+        println!("end seam {}: worst gap {:.1} mm at pair {} of {}", s.name, worst.1 * 1e3, worst.0, gaps.len());
     }
     let n = sim.contact.report(&sim.state.x).intersections;
     println!(

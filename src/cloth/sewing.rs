@@ -2,7 +2,8 @@
 //! ([`SpringKind::Seam`]) join matching vertices of two pieces; their rest lengths start at
 //! the pre-positioned gaps and shrink at the sewing speed, so that the edges are drawn together
 //! gently instead of snapping. Gravity is held off and the motion damped until every thread
-//! has reached rest length 0 and the pieces have settled (`settle` seconds); from then on the
+//! has reached rest length 0, every seam has closed and the pieces have settled (`settle`
+//! seconds), or at the latest until `max_time`; from then on the
 //! threads keep rest length 0: a stitched seam, stiff enough that the gap stays well under a
 //! millimetre, and the garment drapes.
 
@@ -27,6 +28,12 @@ pub struct Sewing {
     pub damping: f64,
     /// Gravity once sewn (m/s²).
     pub gravity: [f64; 3],
+    /// A seam counts as closed when no sewn pair is further apart than this (m).
+    pub closed_gap: f64,
+    /// Gravity comes on at this time even if a seam is still open (s).
+    pub max_time: f64,
+    /// When every seam closed (s), once it has.
+    pub sewn_at: Option<f64>,
 }
 
 impl Sewing {
@@ -64,6 +71,9 @@ impl Sewing {
             settle: 0.1,
             damping: 0.9,
             gravity,
+            closed_gap: 0.002,
+            max_time: 3.0,
+            sewn_at: None,
         }
     }
 
@@ -77,15 +87,29 @@ impl Sewing {
         }
     }
 
-    /// Whether time `t` is still in the sewing phase (threads shortening or settling).
+    /// Whether time `t` is still in the sewing phase: threads shortening, seams not yet
+    /// closed, or settling after they closed (never past `max_time`).
     pub fn sewing_at(&self, t: f64) -> bool {
-        t < self.closing_time() + self.settle
+        if t >= self.max_time {
+            return false;
+        }
+        match self.sewn_at {
+            Some(s) => t < s + self.settle,
+            None => true,
+        }
     }
 
-    /// Sets the threads' rest lengths for time `t` and returns the gravity to use.
-    pub fn update(&self, model: &mut ClothModel, t: f64) -> [f64; 3] {
+    /// Sets the threads' rest lengths for time `t` (the cloth at `x`), notes when the seams
+    /// have closed, and returns the gravity to use.
+    pub fn update(&mut self, model: &mut ClothModel, t: f64, x: &[Vec3]) -> [f64; 3] {
         for (k, s) in model.springs[self.springs.clone()].iter_mut().enumerate() {
             s.rest = (self.initial[k] - self.speed * t).max(0.0);
+        }
+        if self.sewn_at.is_none()
+            && t >= self.closing_time()
+            && self.max_gap(model, x) <= self.closed_gap
+        {
+            self.sewn_at = Some(t);
         }
         if self.sewing_at(t) {
             [0.0; 3]

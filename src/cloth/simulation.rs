@@ -334,8 +334,8 @@ impl Simulation {
     fn step_inner(&mut self) -> Result<StepStats, ClothError> {
         self.params.validate()?;
         let t_start = Instant::now();
-        if let Some(sew) = &self.sewing {
-            self.params.gravity = sew.update(&mut self.model, self.state.time);
+        if let Some(sew) = &mut self.sewing {
+            self.params.gravity = sew.update(&mut self.model, self.state.time, &self.state.x);
         }
         self.x_save.copy_from_slice(&self.state.x);
         self.v_save.copy_from_slice(&self.state.v);

@@ -39,7 +39,7 @@ impl Default for DressParameters {
             mesh: MeshParameters::default(),
             preposition: PrepositionParameters::default(),
             seam_stiffness: 300.0,
-            seam_max_force: 0.3,
+            seam_max_force: 1.0,
             sewing_speed: 0.3,
             contact: ContactSettings {
                 self_collision: true,

@@ -32,11 +32,16 @@ use crate::geometry::Vec3;
 pub struct PrepositionParameters {
     /// Distance kept between the garment and the skin (m), the seed's d_z.
     pub clearance: f64,
+    /// Relaxation sweeps after the mapping (0: none).
+    pub relax_iterations: usize,
 }
 
 impl Default for PrepositionParameters {
     fn default() -> Self {
-        PrepositionParameters { clearance: 0.012 }
+        PrepositionParameters {
+            clearance: 0.012,
+            relax_iterations: 60,
+        }
     }
 }
 
@@ -45,7 +50,11 @@ impl Default for PrepositionParameters {
 pub struct PrepositionReport {
     /// Garment vertices.
     pub vertices: usize,
-    /// Mean |L/L0 − 1| over the mesh edges.
+    /// Mean |L/L0 − 1| over the mesh edges after the mapping, before relaxation.
+    pub initial_mean_strain: f64,
+    /// Largest |L/L0 − 1| after the mapping, before relaxation.
+    pub initial_max_strain: f64,
+    /// Mean |L/L0 − 1| over the mesh edges at the end.
     pub mean_strain: f64,
     /// Largest |L/L0 − 1|.
     pub max_strain: f64,
@@ -245,14 +254,9 @@ pub fn preposition(
         ..Default::default()
     };
     let reach = 1.0;
-    for p in x.iter_mut() {
-        if let Some(pr) = skin.proximity(p, reach) {
-            if pr.distance < 0.5 * dz {
-                *p += pr.normal * (dz - pr.distance);
-                report.pushed_out += 1;
-            }
-        }
-    }
+    report.pushed_out = push_out(&mut x, skin, dz);
+    (report.initial_mean_strain, report.initial_max_strain) = edge_strain(garment, &x);
+    relax(garment, &mut x, skin, dz, params.relax_iterations);
     report.min_distance = f64::MAX;
     for p in &x {
         if let Some(pr) = skin.proximity(p, reach) {
@@ -392,6 +396,64 @@ fn over_the_top(
         Side::Back => {
             let room = (mid - fin - d).max(0.0);
             (top + (e - room).max(0.0), d + e.min(room))
+        }
+    }
+}
+
+/// Moves vertices closer to the skin than half the clearance out to the clearance, along the
+/// skin normal; returns how many moved.
+fn push_out(x: &mut [Vec3], skin: &MeshBody, dz: f64) -> usize {
+    let mut moved = 0;
+    for p in x.iter_mut() {
+        if let Some(pr) = skin.proximity(p, 1.0) {
+            if pr.distance < 0.5 * dz {
+                *p += pr.normal * (dz - pr.distance);
+                moved += 1;
+            }
+        }
+    }
+    moved
+}
+
+/// Removes what is left of the mapping's distortion: Jacobi sweeps that move each edge's ends
+/// towards its rest length (the stretch part of the cloth's energy, minimised locally), every
+/// fifth sweep keeping the skin clear.
+fn relax(garment: &GarmentMesh, x: &mut [Vec3], skin: &MeshBody, dz: f64, sweeps: usize) {
+    let m = &garment.mesh;
+    let mut edges: Vec<(usize, usize, f64)> = Vec::with_capacity(3 * m.triangles.len());
+    for t in &m.triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let r = (m.rest[a][0] - m.rest[b][0]).hypot(m.rest[a][1] - m.rest[b][1]);
+            edges.push((a.min(b), a.max(b), r));
+        }
+    }
+    edges.sort_by(|p, q| (p.0, p.1).cmp(&(q.0, q.1)));
+    edges.dedup_by(|p, q| p.0 == q.0 && p.1 == q.1);
+    let mut corr = vec![Vec3::zeros(); x.len()];
+    let mut count = vec![0u32; x.len()];
+    for &(a, b, _) in &edges {
+        count[a] += 1;
+        count[b] += 1;
+    }
+    for sweep in 0..sweeps {
+        corr.fill(Vec3::zeros());
+        for &(a, b, r) in &edges {
+            let d = x[b] - x[a];
+            let l = d.norm();
+            if l > 1e-12 {
+                let c = d * (0.5 * (l - r) / l);
+                corr[a] += c;
+                corr[b] -= c;
+            }
+        }
+        for v in 0..x.len() {
+            if count[v] > 0 {
+                x[v] += corr[v] / count[v] as f64;
+            }
+        }
+        if sweep % 5 == 4 || sweep + 1 == sweeps {
+            push_out(x, skin, dz);
         }
     }
 }
