@@ -26,6 +26,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let man = Mannequin::load_makehuman(&data)?;
     let mut params = DressParameters::default();
     params.mesh.edge_length = edge;
+    if let Ok(r) = std::env::var("RELAX") {
+        params.preposition.relax_iterations = r.parse()?;
+    }
+    if let Ok(f) = std::env::var("SEAM_FORCE") {
+        params.seam_max_force = f.parse()?;
+    }
+    if let Ok(f) = std::env::var("SELF") {
+        params.contact.self_collision = f == "1";
+    }
     let sim_params = SimulationParameters::default();
     let mut d = dress(
         &pattern,
@@ -68,8 +77,42 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for s in &d.garment.seams {
         let x = &sim.state.x;
         let gaps: Vec<f64> = s.pairs.iter().map(|&(a, b)| (x[a] - x[b]).norm()).collect();
-        let worst = gaps.iter().cloned().enumerate().fold((0, 0.0), |w, (i, g)| if g > w.1 { (i, g) } else { w });
-        println!("end seam {}: worst gap {:.1} mm at pair {} of {}", s.name, worst.1 * 1e3, worst.0, gaps.len());
+        let worst = gaps
+            .iter()
+            .cloned()
+            .enumerate()
+            .fold((0, 0.0), |w, (i, g)| if g > w.1 { (i, g) } else { w });
+        println!(
+            "end seam {}: worst gap {:.1} mm at pair {} of {}",
+            s.name,
+            worst.1 * 1e3,
+            worst.0,
+            gaps.len()
+        );
+    }
+    if let Shape::Mesh(m) = &sim.contact.bodies[0].shape {
+        let mut inside: Vec<(f64, usize)> = sim
+            .state
+            .x
+            .iter()
+            .enumerate()
+            .filter_map(|(i, p)| {
+                m.proximity(p, 1.0)
+                    .filter(|q| q.distance < 0.0)
+                    .map(|q| (q.distance, i))
+            })
+            .collect();
+        inside.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for (dist, i) in inside.iter().take(8) {
+            let p = sim.state.x[*i];
+            println!(
+                "inside {:.1} mm: vertex {i} at ({:.3}, {:.3}, {:.3})",
+                dist * 1e3,
+                p.x,
+                p.y,
+                p.z
+            );
+        }
     }
     let n = sim.contact.report(&sim.state.x).intersections;
     println!(

@@ -26,6 +26,9 @@ pub struct Sewing {
     pub settle: f64,
     /// Velocity kept per step while sewing (1 = undamped).
     pub damping: f64,
+    /// Largest particle speed while sewing (m/s): sewing is slow, so that contact with the
+    /// body, which looks one step ahead, always sees the cloth coming.
+    pub max_speed: f64,
     /// Gravity once sewn (m/s²).
     pub gravity: [f64; 3],
     /// A seam counts as closed when no sewn pair is further apart than this (m).
@@ -70,6 +73,7 @@ impl Sewing {
             speed,
             settle: 0.1,
             damping: 0.9,
+            max_speed: 2.0 * speed,
             gravity,
             closed_gap: 0.002,
             max_time: 3.0,
@@ -115,6 +119,20 @@ impl Sewing {
             [0.0; 3]
         } else {
             self.gravity
+        }
+    }
+
+    /// Damps and caps the velocities `v` while sewing at time `t`.
+    pub fn slow_down(&self, t: f64, v: &mut [Vec3]) {
+        if !self.sewing_at(t) {
+            return;
+        }
+        for vi in v.iter_mut() {
+            *vi *= self.damping;
+            let s = vi.norm();
+            if s > self.max_speed {
+                *vi *= self.max_speed / s;
+            }
         }
     }
 

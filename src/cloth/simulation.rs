@@ -336,6 +336,7 @@ impl Simulation {
         let t_start = Instant::now();
         if let Some(sew) = &mut self.sewing {
             self.params.gravity = sew.update(&mut self.model, self.state.time, &self.state.x);
+            self.contact.frictionless = sew.sewing_at(self.state.time);
         }
         self.x_save.copy_from_slice(&self.state.x);
         self.v_save.copy_from_slice(&self.state.v);
@@ -354,11 +355,7 @@ impl Simulation {
             return Err(err);
         }
         if let Some(sew) = &self.sewing {
-            if sew.sewing_at(self.state.time) {
-                for v in self.state.v.iter_mut() {
-                    *v *= sew.damping;
-                }
-            }
+            sew.slow_down(self.state.time, &mut self.state.v);
         }
         self.contact_stats(&mut st);
         st.step = self.state.step;

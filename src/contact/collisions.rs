@@ -163,6 +163,8 @@ pub struct Collisions {
     pub stats: ContactStats,
     /// Particles that follow mesh bodies.
     pub pins: Vec<BodyPin>,
+    /// Contacts slide without friction while set (a garment being sewn slips into place).
+    pub frictionless: bool,
     slots: Vec<Slot>,
     last_impulse: Vec<f64>,
     stuck: Vec<bool>,
@@ -387,10 +389,16 @@ impl Collisions {
                 self.stuck[i] = false;
                 continue;
             }
-            let mu = self
+            let mut mu = self
                 .settings
                 .friction
                 .combine(&self.bodies[s.body as usize].friction);
+            if self.frictionless {
+                mu = FrictionCoefficients {
+                    static_: 0.0,
+                    kinetic: 0.0,
+                };
+            }
             if s.stuck {
                 let jt = (impulse[i] - s.normal * jn).norm();
                 self.stuck[i] = jt <= mu.static_ * jn;
@@ -412,7 +420,7 @@ impl Collisions {
         }
         // push-out (Provot) and body statistics
         if !self.bodies.is_empty() {
-            self.push_out(x, v, filter, 0.5 * h, None);
+            self.push_out(x_old, x, v, filter, 0.5 * h, None);
         }
         // cloth–cloth
         if self.settings.self_collision {
@@ -435,7 +443,7 @@ impl Collisions {
                 );
                 if !self.bodies.is_empty() && sc.moved_any() {
                     let moved = sc.moved().to_vec();
-                    self.push_out(x, v, filter, 0.1 * h, Some(&moved));
+                    self.push_out(x_old, x, v, filter, 0.1 * h, Some(&moved));
                 }
                 self.stats.self_contacts = rep.proximities;
                 self.stats.ccd_hits = rep.ccd_hits;
@@ -473,10 +481,12 @@ impl Collisions {
     }
 
     /// Moves vertices closer than `target` to a body back out to `target` and removes their
-    /// approaching normal velocity. Only vertices with `only[i]` when given. Vertices found
-    /// inside a body at the last statistics pass are searched that deep.
+    /// approaching normal velocity. Only vertices with `only[i]` when given. A vertex is searched
+    /// as deep as it was found inside a body at the last statistics pass plus how far it moved
+    /// this step (from `x_old`): one that crossed the thickness in one step is still found.
     fn push_out(
         &self,
+        x_old: &[Vec3],
         x: &mut [Vec3],
         v: &mut [Vec3],
         filter: &Filter,
@@ -496,7 +506,7 @@ impl Collisions {
                 {
                     return;
                 }
-                let reach = h + depth.get(i).copied().unwrap_or(0.0);
+                let reach = h + depth.get(i).copied().unwrap_or(0.0) + (*xi - x_old[i]).norm();
                 for b in bodies {
                     let (lo, hi) = b.bounds();
                     if (0..3).any(|a| xi[a] < lo[a] - reach || xi[a] > hi[a] + reach) {
