@@ -124,7 +124,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Shape::Mesh(m) => (m.positions().to_vec(), m.triangles().to_vec()),
         _ => unreachable!(),
     };
-    let target = Vec3::new(0.0, 0.0, 1.15);
+    let target = Vec3::new(0.0, 0.0, if name == "aaron" { 1.15 } else { 0.8 });
     for (view, eye) in [
         ("front", Vec3::new(0.0, -1.7, 1.25)),
         ("side", Vec3::new(1.7, 0.0, 1.25)),

@@ -650,16 +650,10 @@ fn build_row(
         let (a, b) = (s_of(side, iv.x0), s_of(side, iv.x1));
         (a.min(b), a.max(b))
     };
-    let margin = 2.0 * sil.cell;
+    // intervals meet only through the body sections they cover: the crotch extensions of two
+    // trouser fronts overlap on the centre line, yet each front dresses its own leg
     for a in 0..ni {
         let (a0, a1) = span(&intervals[a]);
-        for b in a + 1..ni {
-            let (b0, b1) = span(&intervals[b]);
-            if a0 < b1 - margin && b0 < a1 - margin {
-                let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-                parent[ra] = rb;
-            }
-        }
         let mut joined = false;
         for (k, sec) in sections.iter().enumerate() {
             // a section joins when the interval covers its middle: an arm hanging beside a
@@ -700,10 +694,13 @@ fn build_row(
         .map(|g| {
             let members: Vec<&Interval> = intervals.iter().filter(|iv| iv.group == g).collect();
             let mut pts: Vec<[f64; 2]> = Vec::new();
+            let (mut body_lo, mut body_hi) = (f64::MAX, f64::MIN);
             for (k, sec) in sections.iter().enumerate() {
                 let r = find(&mut parent, ni + k);
                 if root_group[r] == g {
                     pts.extend_from_slice(&sec.2);
+                    body_lo = body_lo.min(sec.0);
+                    body_hi = body_hi.max(sec.1);
                 }
             }
             if pts.is_empty() {
@@ -729,9 +726,15 @@ fn build_row(
             };
             let fc = centre(Side::Front);
             let bc = centre(Side::Back);
-            // a side with no piece in this row takes the other side's centre line
-            let fc_s = fc.or(bc.map(|b| -b)).unwrap_or(0.0);
-            let bc_s = bc.map(|b| -b).unwrap_or(fc_s);
+            // the garment row is centred on the body it dresses (a trouser leg on its leg);
+            // with no body under it, on its own pieces
+            let (fc_s, bc_s) = if body_lo <= body_hi {
+                let c = 0.5 * (body_lo + body_hi);
+                (c, c)
+            } else {
+                let f = fc.or(bc.map(|b| -b)).unwrap_or(0.0);
+                (f, bc.map(|b| -b).unwrap_or(f))
+            };
             Group {
                 shell,
                 k,
