@@ -99,10 +99,8 @@ struct Interval {
 /// A group's shell and the arc positions of its front and back centres.
 struct Group {
     shell: Shell,
-    /// Widening factor of the shell's perimeter (≥ 1).
+    /// Widening factor of the shell (≥ 1).
     k: f64,
-    /// Room across: the shell may not widen past these (other body sections, e.g. arms).
-    room: (f64, f64),
     /// Left coordinates of the front and back centres.
     centre_s: [f64; 2],
     front_arc: f64,
@@ -116,8 +114,7 @@ impl Group {
     fn finish(&mut self, k: f64) {
         self.k = k;
         if k > 1.0 {
-            let target = k * self.shell.perimeter();
-            self.shell = self.shell.widened(target, self.room.0, self.room.1);
+            self.shell = self.shell.scaled(k);
         }
         self.front_arc = self.shell.arc_at(self.centre_s[0], true);
         self.back_arc = self.shell.arc_at(self.centre_s[1], false);
@@ -716,18 +713,6 @@ fn build_row(
             let Some(shell) = Shell::around(&pts, dz) else {
                 unreachable_shell()
             };
-            // sections of other groups (arms) bound the room across
-            let mut room = (f64::MIN, f64::MAX);
-            for (k, sec) in sections.iter().enumerate() {
-                let r = find(&mut parent, ni + k);
-                if root_group[r] != g && body_lo <= body_hi {
-                    if sec.1 <= body_lo {
-                        room.0 = room.0.max(sec.1 + dz);
-                    } else if sec.0 >= body_hi {
-                        room.1 = room.1.min(sec.0 - dz);
-                    }
-                }
-            }
             let width: f64 = members.iter().map(|iv| iv.x1 - iv.x0).sum();
             let k = (width / shell.perimeter()).max(1.0);
             let centre = |side: Side| {
@@ -753,7 +738,6 @@ fn build_row(
             Group {
                 shell,
                 k,
-                room,
                 centre_s: [fc_s, bc_s],
                 front_arc: 0.0,
                 back_arc: 0.0,

@@ -93,59 +93,6 @@ impl Shell {
         Shell::from_clockwise(pts)
     }
 
-    /// The shell scaled about its vertex centroid by `ks` across (s) and `kd` in depth (d).
-    pub fn scaled2(&self, ks: f64, kd: f64) -> Shell {
-        let n = self.pts.len() as f64;
-        let c = self
-            .pts
-            .iter()
-            .fold([0.0, 0.0], |a, p| [a[0] + p[0] / n, a[1] + p[1] / n]);
-        let pts = self
-            .pts
-            .iter()
-            .map(|p| [c[0] + ks * (p[0] - c[0]), c[1] + kd * (p[1] - c[1])])
-            .collect();
-        Shell::from_clockwise(pts)
-    }
-
-    /// The shell widened to perimeter `target` (no change if it is already as long), keeping
-    /// its span across within [`s_lo`, `s_hi`] (an arm beside the torso): what cannot go
-    /// sideways goes to the front and back.
-    pub fn widened(&self, target: f64, s_lo: f64, s_hi: f64) -> Shell {
-        let per = self.perimeter();
-        if target <= per {
-            return self.clone();
-        }
-        let n = self.pts.len() as f64;
-        let cs = self.pts.iter().map(|p| p[0]).sum::<f64>() / n;
-        let (lo, hi) = self
-            .pts
-            .iter()
-            .fold((f64::MAX, f64::MIN), |(l, h), p| (l.min(p[0]), h.max(p[0])));
-        let k = target / per;
-        let mut ks = k;
-        if lo < cs {
-            ks = ks.min(((cs - s_lo) / (cs - lo)).max(1.0));
-        }
-        if hi > cs {
-            ks = ks.min(((s_hi - cs) / (hi - cs)).max(1.0));
-        }
-        if ks >= k {
-            return self.scaled(k);
-        }
-        // depth factor by bisection: the perimeter grows with it
-        let (mut a, mut b) = (1.0, 20.0 * k);
-        for _ in 0..60 {
-            let m = 0.5 * (a + b);
-            if self.scaled2(ks, m).perimeter() < target {
-                a = m;
-            } else {
-                b = m;
-            }
-        }
-        self.scaled2(ks, 0.5 * (a + b))
-    }
-
     /// The point at arc length `sigma` (taken modulo the perimeter).
     pub fn at(&self, sigma: f64) -> [f64; 2] {
         let per = self.perimeter();
