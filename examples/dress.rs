@@ -57,6 +57,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     let sim = &mut d.simulation;
+    if let (Ok(g), Some(sew)) = (std::env::var("SEW_G"), sim.sewing.as_mut()) {
+        sew.sewing_gravity = g.parse()?;
+    }
     let _ = &d.garment;
     let steps = sim.steps_for(seconds);
     let mut worst_inside = 0;

@@ -31,6 +31,8 @@ pub struct Sewing {
     pub max_speed: f64,
     /// Gravity once sewn (m/s²).
     pub gravity: [f64; 3],
+    /// Share of gravity acting while sewing (0: none).
+    pub sewing_gravity: f64,
     /// A seam counts as closed when no sewn pair is further apart than this (m).
     pub closed_gap: f64,
     /// Gravity comes on at this time even if a seam is still open (s).
@@ -75,6 +77,7 @@ impl Sewing {
             damping: 0.9,
             max_speed: 2.0 * speed,
             gravity,
+            sewing_gravity: 0.0,
             closed_gap: 0.002,
             max_time: 3.0,
             sewn_at: None,
@@ -116,7 +119,7 @@ impl Sewing {
             self.sewn_at = Some(t);
         }
         if self.sewing_at(t) {
-            [0.0; 3]
+            self.gravity.map(|g| g * self.sewing_gravity)
         } else {
             self.gravity
         }

@@ -25,6 +25,9 @@ pub struct DressParameters {
     pub seam_stiffness: f64,
     /// Largest pull of a seam thread (N).
     pub seam_max_force: f64,
+    /// Share of gravity acting while sewing (the garment settles onto the shoulders or hips
+    /// as it is sewn).
+    pub sewing_gravity: f64,
     /// How fast the seam threads shorten while sewing (m/s).
     pub sewing_speed: f64,
     /// Contact with the body and self-collision.
@@ -39,7 +42,8 @@ impl Default for DressParameters {
             mesh: MeshParameters::default(),
             preposition: PrepositionParameters::default(),
             seam_stiffness: 300.0,
-            seam_max_force: 1.0,
+            seam_max_force: 5.0,
+            sewing_gravity: 0.3,
             sewing_speed: 0.3,
             contact: ContactSettings {
                 self_collision: true,
@@ -99,6 +103,9 @@ pub fn dress(
     if !(params.seam_max_force.is_finite() && params.seam_max_force > 0.0) {
         return Err(bad("seam_max_force", params.seam_max_force));
     }
+    if !(params.sewing_gravity.is_finite() && (0.0..=1.0).contains(&params.sewing_gravity)) {
+        return Err(bad("sewing_gravity", params.sewing_gravity));
+    }
     if !(params.sewing_speed.is_finite() && params.sewing_speed > 0.0) {
         return Err(bad("sewing_speed", params.sewing_speed));
     }
@@ -135,7 +142,7 @@ pub fn dress(
         .flat_map(|s| s.pairs.iter().copied())
         .filter(|(a, b)| a != b)
         .collect();
-    let sewing = Sewing::add_to(
+    let mut sewing = Sewing::add_to(
         &mut model,
         &pairs,
         &x,
@@ -156,6 +163,7 @@ pub fn dress(
         preposition: pre,
         closing_time: sewing.closing_time(),
     };
+    sewing.sewing_gravity = params.sewing_gravity;
     sim.sewing = Some(sewing);
     Ok(Dressed {
         garment,
