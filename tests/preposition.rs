@@ -3,6 +3,8 @@
 //! of front and back pieces meet. Patterns are built here by hand so that the expected figures
 //! are known: a straight skirt whose width is given.
 
+mod support;
+
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
@@ -137,4 +139,63 @@ fn a_loose_skirt_is_placed_outside_the_body_with_little_strain() {
     let tl = g.pieces[0].corners.iter().find(|c| c.0 == "tl").unwrap().1;
     let h = f.to_body(&x[tl])[1];
     assert!((h - (b.marks.waist + 0.02)).abs() < 0.01, "{h}");
+}
+
+/// The three FreeSewing garments: pre-positioning alone leaves every vertex outside the skin
+/// (checked here with an independent ray-parity test against the skin mesh) and a mean edge
+/// strain under 10 %.
+#[test]
+fn freesewing_garments_are_prepositioned_outside_the_body() {
+    let b = body();
+    let dir = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data"))
+        .join("bodies/makehuman");
+    let m = Mannequin::load_makehuman(&dir).unwrap();
+    let skin: Vec<[f64; 3]> = m.rest_positions().iter().map(|p| [p.x, p.y, p.z]).collect();
+    for name in ["aaron", "penelope", "paco"] {
+        let pat = emilion::garment::read_garment(format!(
+            "{}/scripts/patterns/{name}.garment.json",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .unwrap();
+        let g = mesh_pattern(
+            &pat,
+            &MeshParameters {
+                edge_length: 0.02,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let (x, rep) = preposition(
+            &pat,
+            &g,
+            &b.sil,
+            &b.marks,
+            &b.skin,
+            &PrepositionParameters::default(),
+        )
+        .unwrap();
+        assert!(
+            rep.mean_strain < 0.10,
+            "{name}: mean strain {}",
+            rep.mean_strain
+        );
+        let inside = x
+            .iter()
+            .filter(|p| {
+                let q = [p.x, p.y, p.z];
+                let far = [q[0] + 31.7, q[1] + 17.3, q[2] + 23.9];
+                m.triangles()
+                    .iter()
+                    .filter(|t| {
+                        support::intersections::segment_triangle_intersect_exact(
+                            q, far, skin[t[0]], skin[t[1]], skin[t[2]],
+                        )
+                    })
+                    .count()
+                    % 2
+                    == 1
+            })
+            .count();
+        assert_eq!(inside, 0, "{name}: {inside} vertices inside the body");
+    }
 }
