@@ -20,6 +20,8 @@
 use std::time::Instant;
 
 use super::mesh::GarmentMesh;
+use super::over_the_top::{column_tops, over_the_top, over_the_top_lifts};
+use super::relax::{push_out, relax};
 use super::shell::Shell;
 use super::silhouette::{Landmarks, Silhouettes};
 use super::{Pattern, PatternError, Side, P2};
@@ -69,11 +71,11 @@ pub struct PrepositionReport {
 }
 
 /// The figurine (front or back view) transform of a piece: flat point ↦ (X, height).
-struct Figurine {
-    side: Side,
+pub(super) struct Figurine {
+    pub(super) side: Side,
     rot: [f64; 4],
     anchor: P2,
-    at: P2,
+    pub(super) at: P2,
 }
 
 impl Figurine {
@@ -201,22 +203,6 @@ pub fn preposition(
             g.finish(f);
         }
     }
-    if std::env::var("EMILION_DEBUG_PREPOSITION").is_ok() {
-        for (k, pm) in garment.pieces.iter().enumerate() {
-            let top = pm
-                .vertices
-                .clone()
-                .max_by(|&a, &b| fig_pos[a][1].total_cmp(&fig_pos[b][1]));
-            if let Some(v) = top {
-                let [fx, fy] = fig_pos[v];
-                let j = sil.col(s_of(figs[k].side, fx));
-                eprintln!(
-                    "piece {}: top at X {fx:.3} h {fy:.3}; column top {:?}; shoulder {:.3} neck {:.3}",
-                    pm.name, tops[j].map(|i| sil.h_of(i)), marks.shoulder, marks.neck
-                );
-            }
-        }
-    }
     let mut x = vec![Vec3::zeros(); n];
     for v in 0..n {
         let [fx, fy] = fig_pos[v];
@@ -267,195 +253,10 @@ pub fn preposition(
         }
     }
     let (mean, max) = edge_strain(garment, &x);
-    if std::env::var("EMILION_DEBUG_PREPOSITION").is_ok() {
-        let m = &garment.mesh;
-        let mut worst: Vec<(f64, usize, usize)> = Vec::new();
-        for t in &m.triangles {
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                let r = (m.rest[a][0] - m.rest[b][0]).hypot(m.rest[a][1] - m.rest[b][1]);
-                worst.push(((x[a] - x[b]).norm() / r - 1.0, a, b));
-            }
-        }
-        worst.sort_by(|p, q| q.0.total_cmp(&p.0));
-        let over: usize = worst.iter().filter(|w| w.0 > 0.3).count();
-        eprintln!("edges over 30 %: {over} of {}", worst.len());
-        for w in worst.iter().step_by(10).take(12) {
-            let b = sil.frame.to_body(&x[w.1]);
-            eprintln!(
-                "strain {:.2} at fig {:?} piece {} body s {:.3} h {:.3} d {:.3}",
-                w.0, fig_pos[w.1], piece_of[w.1], b[0], b[1], b[2]
-            );
-        }
-    }
     report.mean_strain = mean;
     report.max_strain = max;
     report.seconds = start.elapsed().as_secs_f64();
     Ok((x, report))
-}
-
-/// How far each piece must rise so that the seams joining a front piece to a back piece over
-/// the top of the body (shoulder seams) meet when both are laid over the top
-/// ([`over_the_top`]): for each such seam, half of what its two edges lack to cover the body's
-/// depth there; a piece takes the largest of its seams. Seams elsewhere (side seams, which the
-/// shells already close) ask for nothing.
-#[allow(clippy::too_many_arguments)]
-fn over_the_top_lifts(
-    garment: &GarmentMesh,
-    figs: &[Figurine],
-    fig_pos: &[P2],
-    piece_of: &[usize],
-    sil: &Silhouettes,
-    marks: &Landmarks,
-    tops: &[Option<usize>],
-    dz: f64,
-) -> Vec<f64> {
-    let mut lift = vec![0.0f64; figs.len()];
-    let fin = 0.5 * dz;
-    for seam in &garment.seams {
-        let (mut need, mut count) = (0.0, 0usize);
-        let mut pieces = None;
-        for &(a, b) in &seam.pairs {
-            let (pa, pb) = (piece_of[a], piece_of[b]);
-            if figs[pa].side == figs[pb].side {
-                continue;
-            }
-            let (f, bk) = if figs[pa].side == Side::Front {
-                (a, b)
-            } else {
-                (b, a)
-            };
-            let s = s_of(Side::Front, fig_pos[f][0]);
-            let j = sil.col(s);
-            let Some(i) = tops[j] else { continue };
-            let top = sil.h_of(i).min(marks.neck) + dz;
-            let (yf, yb) = (fig_pos[f][1], fig_pos[bk][1]);
-            // only seams that end near the top of the body, not side seams
-            if yf < top - 0.04 || yb < top - 0.04 {
-                continue;
-            }
-            let Some((df, db)) = sil.depths(i, j) else {
-                continue;
-            };
-            need += 0.5 * ((df - db) + 2.0 * dz - 2.0 * fin - (yf - top) - (yb - top));
-            count += 1;
-            pieces = Some((piece_of[f], piece_of[bk]));
-        }
-        if let (Some((pf, pb)), true) = (pieces, count > 0) {
-            let l = (need / count as f64).max(0.0);
-            lift[pf] = lift[pf].max(l);
-            lift[pb] = lift[pb].max(l);
-        }
-    }
-    lift
-}
-
-/// Per silhouette column, the highest covered row no higher than the neck (the top of the
-/// shoulder under a strap), or `None` for an empty column.
-fn column_tops(sil: &Silhouettes, marks: &Landmarks) -> Vec<Option<usize>> {
-    let cap = sil.row(marks.neck);
-    (0..sil.ns)
-        .map(|j| (0..=cap).rev().find(|&i| sil.covered(i, j)))
-        .collect()
-}
-
-/// A vertex of the figurine that rises above the body's top at its column (a strap above the
-/// shoulder) is laid over the top instead, front pieces towards the back and back pieces
-/// towards the front, up to a fin just off the body's mid-depth where the two meet (the seed's
-/// 3D silhouette): returns its height and depth.
-#[allow(clippy::too_many_arguments)]
-fn over_the_top(
-    sil: &Silhouettes,
-    marks: &Landmarks,
-    tops: &[Option<usize>],
-    side: Side,
-    s: f64,
-    y: f64,
-    d: f64,
-    dz: f64,
-) -> (f64, f64) {
-    let j = sil.col(s);
-    let Some(i) = tops[j] else {
-        return (y, d);
-    };
-    let top = sil.h_of(i).min(marks.neck) + dz;
-    if y <= top {
-        return (y, d);
-    }
-    let Some((f, b)) = sil.depths(i, j) else {
-        return (y, d);
-    };
-    let e = y - top;
-    let fin = 0.5 * dz;
-    let mid = 0.5 * (f + b);
-    match side {
-        Side::Front => {
-            let room = (d - mid - fin).max(0.0);
-            (top + (e - room).max(0.0), d - e.min(room))
-        }
-        Side::Back => {
-            let room = (mid - fin - d).max(0.0);
-            (top + (e - room).max(0.0), d + e.min(room))
-        }
-    }
-}
-
-/// Moves vertices closer to the skin than half the clearance out to the clearance, along the
-/// skin normal; returns how many moved.
-fn push_out(x: &mut [Vec3], skin: &MeshBody, dz: f64) -> usize {
-    let mut moved = 0;
-    for p in x.iter_mut() {
-        if let Some(pr) = skin.proximity(p, 1.0) {
-            if pr.distance < 0.5 * dz {
-                *p += pr.normal * (dz - pr.distance);
-                moved += 1;
-            }
-        }
-    }
-    moved
-}
-
-/// Removes what is left of the mapping's distortion: Jacobi sweeps that move each edge's ends
-/// towards its rest length (the stretch part of the cloth's energy, minimised locally), every
-/// fifth sweep keeping the skin clear.
-fn relax(garment: &GarmentMesh, x: &mut [Vec3], skin: &MeshBody, dz: f64, sweeps: usize) {
-    let m = &garment.mesh;
-    let mut edges: Vec<(usize, usize, f64)> = Vec::with_capacity(3 * m.triangles.len());
-    for t in &m.triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            let r = (m.rest[a][0] - m.rest[b][0]).hypot(m.rest[a][1] - m.rest[b][1]);
-            edges.push((a.min(b), a.max(b), r));
-        }
-    }
-    edges.sort_by(|p, q| (p.0, p.1).cmp(&(q.0, q.1)));
-    edges.dedup_by(|p, q| p.0 == q.0 && p.1 == q.1);
-    let mut corr = vec![Vec3::zeros(); x.len()];
-    let mut count = vec![0u32; x.len()];
-    for &(a, b, _) in &edges {
-        count[a] += 1;
-        count[b] += 1;
-    }
-    for sweep in 0..sweeps {
-        corr.fill(Vec3::zeros());
-        for &(a, b, r) in &edges {
-            let d = x[b] - x[a];
-            let l = d.norm();
-            if l > 1e-12 {
-                let c = d * (0.5 * (l - r) / l);
-                corr[a] += c;
-                corr[b] -= c;
-            }
-        }
-        for v in 0..x.len() {
-            if count[v] > 0 {
-                x[v] += corr[v] / count[v] as f64;
-            }
-        }
-        if sweep % 5 == 4 || sweep + 1 == sweeps {
-            push_out(x, skin, dz);
-        }
-    }
 }
 
 /// Mean and largest |L/L0 − 1| over the garment's edges at positions `x`.
@@ -542,7 +343,7 @@ fn figurines(
 
 /// Left coordinate of a figurine X on a side.
 #[inline]
-fn s_of(side: Side, x: f64) -> f64 {
+pub(super) fn s_of(side: Side, x: f64) -> f64 {
     match side {
         Side::Front => x,
         Side::Back => -x,
