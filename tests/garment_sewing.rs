@@ -11,7 +11,7 @@ use std::path::PathBuf;
 use emilion::body::Mannequin;
 use emilion::cloth::{FabricParameters, SimulationParameters};
 use emilion::garment::{dress, read_garment, DressParameters};
-use support::intersections::{count_edge_triangle_intersections, segment_triangle_intersect_exact};
+use support::intersections::count_edge_triangle_intersections;
 
 #[test]
 fn aaron_is_sewn_and_draped_without_penetration_or_self_intersection() {
@@ -54,21 +54,8 @@ fn aaron_is_sewn_and_draped_without_penetration_or_self_intersection() {
         .iter()
         .map(|p| [p.x, p.y, p.z])
         .collect();
-    let inside = x
-        .iter()
-        .filter(|p| {
-            let q = [p.x, p.y, p.z];
-            let far = [q[0] + 31.7, q[1] + 17.3, q[2] + 23.9];
-            man.triangles()
-                .iter()
-                .filter(|t| {
-                    segment_triangle_intersect_exact(q, far, skin[t[0]], skin[t[1]], skin[t[2]])
-                })
-                .count()
-                % 2
-                == 1
-        })
-        .count();
+    let pts: Vec<[f64; 3]> = x.iter().map(|p| [p.x, p.y, p.z]).collect();
+    let inside = support::inside::count_inside(&pts, &skin, man.triangles());
     assert_eq!(inside, 0, "{inside} garment vertices inside the body");
     // no self-intersection once sewn vertices are one
     for i in 0..rep.len() {
@@ -78,7 +65,6 @@ fn aaron_is_sewn_and_draped_without_penetration_or_self_intersection() {
         }
         rep[i] = r;
     }
-    let pts: Vec<[f64; 3]> = x.iter().map(|p| [p.x, p.y, p.z]).collect();
     let tris: Vec<[usize; 3]> = d
         .garment
         .mesh

@@ -11,9 +11,11 @@ use std::sync::OnceLock;
 use emilion::body::Mannequin;
 use emilion::contact::MeshBody;
 use emilion::garment::{
-    mesh_pattern, preposition, BodyFrame, Copies, Corner, EdgeRef, Landmarks, MeshParameters,
-    Outline, Pattern, Piece, Placement, PrepositionParameters, Seam, Segment, Side, Silhouettes,
+    mesh_pattern, preposition, BodyFrame, Copies, Corner, EdgeRef, GarmentMesh, Landmarks,
+    MeshParameters, Outline, Pattern, Piece, Placement, PrepositionParameters, PrepositionReport,
+    Seam, Segment, Side, Silhouettes,
 };
+use emilion::geometry::Vec3;
 
 struct Body {
     sil: Silhouettes,
@@ -101,20 +103,19 @@ fn skirt(w: f64, h: f64) -> Pattern {
     }
 }
 
-#[test]
-fn a_loose_skirt_is_placed_outside_the_body_with_little_strain() {
+/// Meshes `pat` at `edge` and pre-positions it on the mannequin.
+fn placed(pat: &Pattern, edge: f64) -> (GarmentMesh, Vec<Vec3>, PrepositionReport) {
     let b = body();
-    let pat = skirt(0.56, 0.5);
     let g = mesh_pattern(
-        &pat,
+        pat,
         &MeshParameters {
-            edge_length: 0.015,
+            edge_length: edge,
             ..Default::default()
         },
     )
     .unwrap();
     let (x, rep) = preposition(
-        &pat,
+        pat,
         &g,
         &b.sil,
         &b.marks,
@@ -122,6 +123,14 @@ fn a_loose_skirt_is_placed_outside_the_body_with_little_strain() {
         &PrepositionParameters::default(),
     )
     .unwrap();
+    (g, x, rep)
+}
+
+#[test]
+fn a_loose_skirt_is_placed_outside_the_body_with_little_strain() {
+    let b = body();
+    let pat = skirt(0.56, 0.5);
+    let (g, x, rep) = placed(&pat, 0.015);
     eprintln!("{rep:?}");
     assert_eq!(rep.inside, 0);
     assert!(rep.min_distance > 0.0);
@@ -146,7 +155,6 @@ fn a_loose_skirt_is_placed_outside_the_body_with_little_strain() {
 /// strain under 10 %.
 #[test]
 fn freesewing_garments_are_prepositioned_outside_the_body() {
-    let b = body();
     let dir = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data"))
         .join("bodies/makehuman");
     let m = Mannequin::load_makehuman(&dir).unwrap();
@@ -157,45 +165,14 @@ fn freesewing_garments_are_prepositioned_outside_the_body() {
             env!("CARGO_MANIFEST_DIR")
         ))
         .unwrap();
-        let g = mesh_pattern(
-            &pat,
-            &MeshParameters {
-                edge_length: 0.02,
-                ..Default::default()
-            },
-        )
-        .unwrap();
-        let (x, rep) = preposition(
-            &pat,
-            &g,
-            &b.sil,
-            &b.marks,
-            &b.skin,
-            &PrepositionParameters::default(),
-        )
-        .unwrap();
+        let (_, x, rep) = placed(&pat, 0.02);
         assert!(
             rep.mean_strain < 0.10,
             "{name}: mean strain {}",
             rep.mean_strain
         );
-        let inside = x
-            .iter()
-            .filter(|p| {
-                let q = [p.x, p.y, p.z];
-                let far = [q[0] + 31.7, q[1] + 17.3, q[2] + 23.9];
-                m.triangles()
-                    .iter()
-                    .filter(|t| {
-                        support::intersections::segment_triangle_intersect_exact(
-                            q, far, skin[t[0]], skin[t[1]], skin[t[2]],
-                        )
-                    })
-                    .count()
-                    % 2
-                    == 1
-            })
-            .count();
+        let pts: Vec<[f64; 3]> = x.iter().map(|p| [p.x, p.y, p.z]).collect();
+        let inside = support::inside::count_inside(&pts, &skin, m.triangles());
         assert_eq!(inside, 0, "{name}: {inside} vertices inside the body");
     }
 }
