@@ -21,7 +21,14 @@ fn aaron_script_dresses_the_mannequin_and_writes_its_outputs() {
     if let Err(e) = run_file(&root.join("scripts/aaron.rhai"), &sets) {
         panic!("scripts/aaron.rhai failed:\n{e}");
     }
-    for f in ["front.png", "side.png", "back.png", "garment.glb"] {
+    for f in [
+        "front.png",
+        "side.png",
+        "back.png",
+        "garment.glb",
+        "pattern.png",
+        "pattern.svg",
+    ] {
         let p = out.join("aaron").join(f);
         assert!(
             std::fs::metadata(&p).map(|m| m.len() > 0).unwrap_or(false),

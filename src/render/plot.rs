@@ -102,10 +102,10 @@ pub fn series_colour(index: usize) -> [u8; 3] {
     PALETTE[index % PALETTE.len()]
 }
 
-const FONT_FAMILY: &str = "sans-serif";
+pub(crate) const FONT_FAMILY: &str = "sans-serif";
 static FONT: Once = Once::new();
 
-fn register_embedded_font() {
+pub(crate) fn register_embedded_font() {
     FONT.call_once(|| {
         let bytes: &'static [u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
         // the embedded font is a known good TTF; should it ever fail to parse, drawing
@@ -114,7 +114,7 @@ fn register_embedded_font() {
     });
 }
 
-fn error(path: &Path, message: impl std::fmt::Display) -> PlotError {
+pub(crate) fn error(path: &Path, message: impl std::fmt::Display) -> PlotError {
     PlotError {
         path: path.to_path_buf(),
         message: message.to_string(),
@@ -350,7 +350,7 @@ fn temp_beside(path: &Path) -> PathBuf {
 
 /// Writes `path` atomically: `write` fills a temporary file beside it, which is then renamed
 /// to `path`; on failure the temporary file is removed and the error names `path`.
-fn write_atomic(
+pub(crate) fn write_atomic(
     path: &Path,
     write: impl FnOnce(&Path) -> Result<(), String>,
 ) -> Result<(), PlotError> {
