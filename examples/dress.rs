@@ -4,6 +4,9 @@
 //! `out/examples/<name>_*.png`.
 //!
 //! `cargo run --release --example dress -- [aaron|penelope|paco] [seconds] [edge_m]`
+//!
+//! Environment knobs for experiments: `RELAX` (relaxation sweeps), `SEAM_FORCE` (N),
+//! `SELF` (`0` turns self-collision off), `SEW_G` (share of gravity while sewing).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
