@@ -63,7 +63,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let (Ok(g), Some(sew)) = (std::env::var("SEW_G"), sim.sewing.as_mut()) {
         sew.sewing_gravity = g.parse()?;
     }
-    let _ = &d.garment;
+    if let (Ok(k), Some(sew)) = (std::env::var("STITCH"), sim.sewing.as_mut()) {
+        sew.stitched.0 = k.parse()?;
+    }
     let steps = sim.steps_for(seconds);
     let mut worst_inside = 0;
     for k in 0..steps {
@@ -74,6 +76,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .sewing
                 .as_ref()
                 .map_or(0.0, |s| s.max_gap(&sim.model, &sim.state.x));
+            if std::env::var("DIAG").is_ok() {
+                for s in &d.garment.seams {
+                    let x = &sim.state.x;
+                    let g = s
+                        .pairs
+                        .iter()
+                        .map(|&(a, b)| (x[a] - x[b]).norm())
+                        .fold(0.0, f64::max);
+                    print!("{}:{:.1} ", s.name, g * 1e3);
+                }
+                println!();
+            }
             println!(
                 "t {:.3} s: step {:.1} ms (assemble {:.1}, solve {:.1}, collision {:.1}), cg {}, seam gap {:.2} mm, contacts {}, self {}, min distance {:.4}, penetrating {}",
                 sim.state.time, st.step_ms, st.assemble_ms, st.solve_ms, st.collision_ms, st.cg_iterations, gap * 1e3, st.contacts, st.self_contacts, st.min_distance, st.penetrating
@@ -95,6 +109,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             worst.0,
             gaps.len()
         );
+        if std::env::var("DIAG").is_ok() && worst.1 > 1e-3 {
+            let (a, b) = s.pairs[worst.0];
+            if let Shape::Mesh(m) = &sim.contact.bodies[0].shape {
+                for v in [a, b] {
+                    let dist = m.proximity(&x[v], 1.0).map_or(f64::NAN, |q| q.distance);
+                    println!(
+                        "   vertex {v} at {:.4} {:.4} {:.4}, skin {:.2} mm, speed {:.2e}",
+                        x[v].x,
+                        x[v].y,
+                        x[v].z,
+                        dist * 1e3,
+                        sim.state.v[v].norm()
+                    );
+                }
+            }
+        }
     }
     if let Shape::Mesh(m) = &sim.contact.bodies[0].shape {
         let mut inside: Vec<(f64, usize)> = sim
@@ -121,6 +151,47 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     let n = sim.contact.report(&sim.state.x).intersections;
+    if std::env::var("DIAG").is_ok() {
+        let mut owner = vec![0usize; sim.state.x.len()];
+        for (k, p) in d.garment.pieces.iter().enumerate() {
+            for v in p.vertices.clone() {
+                owner[v] = k;
+            }
+        }
+        let mut by: std::collections::BTreeMap<(String, String), (usize, Vec3)> =
+            Default::default();
+        for (e, t) in sim.contact.self_intersections(&sim.state.x) {
+            let (a, b) = (owner[e[0] as usize], owner[t[0] as usize]);
+            let key = (
+                d.garment.pieces[a.min(b)].name.clone(),
+                d.garment.pieces[a.max(b)].name.clone(),
+            );
+            let entry = by.entry(key).or_insert((0, Vec3::zeros()));
+            entry.0 += 1;
+            entry.1 = sim.state.x[e[0] as usize];
+            if a != b && entry.0 <= 3 {
+                let f = |v: u32| d.garment.flat[v as usize];
+                let x = |v: u32| sim.state.x[v as usize];
+                println!(
+                    "  edge of {} flat {:?} {:?} at {:?} {:?}; tri of {} flat {:?} at {:?}",
+                    d.garment.pieces[a].name,
+                    f(e[0]),
+                    f(e[1]),
+                    x(e[0]),
+                    x(e[1]),
+                    d.garment.pieces[b].name,
+                    f(t[0]),
+                    x(t[0])
+                );
+            }
+        }
+        for ((a, b), (c, p)) in by {
+            println!(
+                "intersections {a} x {b}: {c} (one at {:.3} {:.3} {:.3})",
+                p.x, p.y, p.z
+            );
+        }
+    }
     println!(
         "total {:.1} s; self-intersections {n}; worst penetrating {worst_inside}",
         t0.elapsed().as_secs_f64()

@@ -4,8 +4,8 @@
 //! gently instead of snapping. Gravity is held off and the motion damped until every thread
 //! has reached rest length 0, every seam has closed and the pieces have settled (`settle`
 //! seconds), or at the latest until `max_time`; from then on the
-//! threads keep rest length 0: a stitched seam, stiff enough that the gap stays well under a
-//! millimetre, and the garment drapes.
+//! threads keep rest length 0 and stiffen ([`Sewing::stitched`]): a stitched seam, stiff enough
+//! that the gap stays well under a millimetre, and the garment drapes.
 
 use std::ops::Range;
 
@@ -39,6 +39,10 @@ pub struct Sewing {
     pub max_time: f64,
     /// When every seam closed (s), once it has.
     pub sewn_at: Option<f64>,
+    /// Stiffness (N/m) and largest pull (N) of the threads once the sewing phase is over:
+    /// the stitched seam, stiffer than the threads that drew the edges together so that the
+    /// fabric's tension across it opens no visible gap.
+    pub stitched: (f64, f64),
 }
 
 impl Sewing {
@@ -81,6 +85,7 @@ impl Sewing {
             closed_gap: 0.002,
             max_time: 3.0,
             sewn_at: None,
+            stitched: (10.0 * stiffness, 10.0 * max_force),
         }
     }
 
@@ -117,6 +122,17 @@ impl Sewing {
             && self.max_gap(model, x) <= self.closed_gap
         {
             self.sewn_at = Some(t);
+        }
+        if self.sewn_at.is_some() || !self.sewing_at(t) {
+            // stitched from the moment the seams closed: the settling that follows, still
+            // frictionless and without full gravity, pulls the last gaps shut
+            let (stiffness, max_force) = self.stitched;
+            for s in &mut model.springs[self.springs.clone()] {
+                s.kind = SpringKind::Seam {
+                    stiffness,
+                    max_force,
+                };
+            }
         }
         if self.sewing_at(t) {
             self.gravity.map(|g| g * self.sewing_gravity)

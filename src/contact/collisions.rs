@@ -480,6 +480,14 @@ impl Collisions {
         std::mem::replace(&mut self.stats, saved)
     }
 
+    /// The intersecting (edge, triangle) pairs of the cloth at `x` (empty without
+    /// self-collision), for diagnostics.
+    pub fn self_intersections(&mut self, x: &[Vec3]) -> Vec<([u32; 2], [u32; 3])> {
+        self.self_collision
+            .as_mut()
+            .map_or_else(Vec::new, |sc| sc.intersections(x))
+    }
+
     /// Moves vertices closer than `target` to a body back out to `target` and removes their
     /// approaching normal velocity. Only vertices with `only[i]` when given. A vertex is searched
     /// as deep as it was found inside a body at the last statistics pass plus how far it moved

@@ -545,6 +545,12 @@ impl SelfCollision {
     /// Number of (edge, triangle) pairs of the cloth at `x` that intersect, pairs sharing a
     /// vertex excluded (fast floating-point test).
     pub fn count_intersections(&mut self, x: &[Vec3]) -> usize {
+        self.intersections(x).len()
+    }
+
+    /// The (edge, triangle) pairs of the cloth at `x` that intersect, pairs sharing a vertex
+    /// excluded (fast floating-point test), in a deterministic order.
+    pub fn intersections(&mut self, x: &[Vec3]) -> Vec<([u32; 2], [u32; 3])> {
         let tight = |ids: &[u32]| {
             let mut b = Aabb::empty();
             for &i in ids {
@@ -565,7 +571,7 @@ impl SelfCollision {
             .into_par_iter()
             .map(|c| {
                 let mut buf = Vec::new();
-                let mut count = 0;
+                let mut found = Vec::new();
                 for e in c * chunk..((c + 1) * chunk).min(ne) {
                     let [a, b] = edges[e];
                     hash.query(&tight(&[a, b]), &mut buf);
@@ -582,13 +588,14 @@ impl SelfCollision {
                             p[1],
                             p[2],
                         ) {
-                            count += 1;
+                            found.push(([a, b], t));
                         }
                     }
                 }
-                count
+                found
             })
-            .sum()
+            .flatten()
+            .collect()
     }
 }
 

@@ -9,6 +9,7 @@ pub mod dxf_write;
 pub mod error;
 pub mod expand;
 pub mod json;
+mod layers;
 pub mod mesh;
 mod mesh_boundary;
 pub mod outline;

@@ -19,6 +19,7 @@
 
 use std::time::Instant;
 
+use super::layers::{layer_lifts, mean_edge_length};
 use super::mesh::GarmentMesh;
 use super::over_the_top::{column_tops, over_the_top, over_the_top_lifts};
 use super::relax::{push_out, relax};
@@ -36,6 +37,9 @@ pub struct PrepositionParameters {
     pub clearance: f64,
     /// Relaxation sweeps after the mapping (0: none).
     pub relax_iterations: usize,
+    /// Distance (m) by which a piece overlapping an earlier one on the same figurine is lifted
+    /// off it (two layers, such as a skirt's vent extensions); 0 leaves overlaps as they are.
+    pub layer_gap: f64,
 }
 
 impl Default for PrepositionParameters {
@@ -43,6 +47,7 @@ impl Default for PrepositionParameters {
         PrepositionParameters {
             clearance: 0.012,
             relax_iterations: 60,
+            layer_gap: 0.01,
         }
     }
 }
@@ -128,6 +133,9 @@ impl Group {
 /// fast (an armhole).
 const WIDENING_RATE: f64 = 0.4;
 
+/// Distance (m) along a piece over which a layer's lift falls from the layer gap to 0.
+const LAYER_RAMP: f64 = 0.03;
+
 struct Row {
     intervals: Vec<Interval>,
     groups: Vec<Group>,
@@ -148,6 +156,12 @@ pub fn preposition(
     if !(dz.is_finite() && dz > 0.0) {
         return Err(PatternError::Parameter(format!(
             "pre-positioning clearance must be > 0, got {dz}"
+        )));
+    }
+    if !(params.layer_gap.is_finite() && params.layer_gap >= 0.0) {
+        return Err(PatternError::Parameter(format!(
+            "pre-positioning layer_gap must be ≥ 0, got {}",
+            params.layer_gap
         )));
     }
     let mut figs = figurines(pattern, garment, marks)?;
@@ -234,6 +248,23 @@ pub fn preposition(
         let (h, d) = over_the_top(sil, marks, &tops, figs[k].side, s, fy, d, dz);
         x[v] = sil.frame.to_world(s, h, d);
     }
+    // overlapping pieces of one figurine become layers
+    let sides: Vec<Side> = figs.iter().map(|f| f.side).collect();
+    let edge = mean_edge_length(garment);
+    let lifts = layer_lifts(
+        garment,
+        &fig_pos,
+        &sides,
+        params.layer_gap,
+        LAYER_RAMP,
+        0.5 * edge,
+    );
+    if lifts.iter().any(|&l| l > 0.0) {
+        let normals = outward_normals(garment, &x, skin);
+        for ((p, &l), n) in x.iter_mut().zip(&lifts).zip(&normals) {
+            *p += n * l;
+        }
+    }
     // push out what the shells did not keep clear (between rows, sharp features)
     let mut report = PrepositionReport {
         vertices: n,
@@ -257,6 +288,36 @@ pub fn preposition(
     report.max_strain = max;
     report.seconds = start.elapsed().as_secs_f64();
     Ok((x, report))
+}
+
+/// Unit vertex normals of the garment at `x` (area-weighted), each piece's turned away from
+/// the body by a majority of its vertices.
+fn outward_normals(garment: &GarmentMesh, x: &[Vec3], skin: &MeshBody) -> Vec<Vec3> {
+    let mut normals = vec![Vec3::zeros(); x.len()];
+    for t in &garment.mesh.triangles {
+        let n = (x[t[1]] - x[t[0]]).cross(&(x[t[2]] - x[t[0]]));
+        for &v in t {
+            normals[v] += n;
+        }
+    }
+    for pm in &garment.pieces {
+        let votes: i64 = pm
+            .vertices
+            .clone()
+            .step_by(7)
+            .filter_map(|v| {
+                skin.proximity(&x[v], 1.0)
+                    .map(|pr| pr.normal.dot(&normals[v]))
+            })
+            .map(|d| if d >= 0.0 { 1 } else { -1 })
+            .sum();
+        let sign = if votes >= 0 { 1.0 } else { -1.0 };
+        for v in pm.vertices.clone() {
+            let len = normals[v].norm().max(1e-300);
+            normals[v] *= sign / len;
+        }
+    }
+    normals
 }
 
 /// Mean and largest |L/L0 − 1| over the garment's edges at positions `x`.
@@ -514,7 +575,18 @@ fn build_row(
             let Some(shell) = Shell::around(&pts, dz) else {
                 unreachable_shell()
             };
-            let width: f64 = members.iter().map(|iv| iv.x1 - iv.x0).sum();
+            // the length the row takes on the shell: the extent of each side's intervals (a
+            // dart's gap inside a piece is laid out too, to close when sewn)
+            let extent = |side: Side| {
+                let (lo, hi) = members
+                    .iter()
+                    .filter(|iv| figs[iv.piece].side == side)
+                    .fold((f64::MAX, f64::MIN), |(l, h), iv| {
+                        (l.min(iv.x0), h.max(iv.x1))
+                    });
+                (hi - lo).max(0.0)
+            };
+            let width = extent(Side::Front) + extent(Side::Back);
             let k = (width / shell.perimeter()).max(1.0);
             let centre = |side: Side| {
                 let (lo, hi) = members
