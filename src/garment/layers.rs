@@ -5,10 +5,8 @@
 //! lifted away from the body by a layer gap, ramped down with the distance (along the piece)
 //! from the overlap so the piece is not sheared.
 
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
-
 use super::mesh::GarmentMesh;
+use super::mesh_graph::Adjacency;
 use super::{Side, P2};
 
 /// Lift (m, outwards) of every garment vertex so that overlapping pieces form layers.
@@ -123,79 +121,6 @@ fn depth_inside(outline: &[P2], p: P2) -> f64 {
         d2.sqrt()
     } else {
         -d2.sqrt()
-    }
-}
-
-/// Vertex adjacency of a triangle mesh (compressed rows).
-struct Adjacency {
-    start: Vec<usize>,
-    next: Vec<usize>,
-}
-
-impl Adjacency {
-    fn new(triangles: &[[usize; 3]], n: usize) -> Adjacency {
-        let mut pairs: Vec<(usize, usize)> = triangles
-            .iter()
-            .flat_map(|t| {
-                (0..3).flat_map(move |k| [(t[k], t[(k + 1) % 3]), (t[(k + 1) % 3], t[k])])
-            })
-            .collect();
-        pairs.sort_unstable();
-        pairs.dedup();
-        let mut start = vec![0; n + 1];
-        for &(a, _) in &pairs {
-            start[a + 1] += 1;
-        }
-        for i in 0..n {
-            start[i + 1] += start[i];
-        }
-        Adjacency {
-            start,
-            next: pairs.into_iter().map(|(_, b)| b).collect(),
-        }
-    }
-
-    /// Shortest path lengths (in the figurine plane) from `sources` along mesh edges, written
-    /// into `dist` up to `limit` (farther vertices keep their value).
-    fn distances(&self, sources: &[usize], pos: &[P2], limit: f64, dist: &mut [f64]) {
-        let mut heap = BinaryHeap::new();
-        for &s in sources {
-            dist[s] = 0.0;
-            heap.push(Entry(0.0, s));
-        }
-        while let Some(Entry(d, v)) = heap.pop() {
-            if d > dist[v] {
-                continue;
-            }
-            for &w in &self.next[self.start[v]..self.start[v + 1]] {
-                let e = (pos[v][0] - pos[w][0]).hypot(pos[v][1] - pos[w][1]);
-                let dw = d + e;
-                if dw < dist[w] && dw < limit {
-                    dist[w] = dw;
-                    heap.push(Entry(dw, w));
-                }
-            }
-        }
-    }
-}
-
-/// A heap entry ordered by smallest distance first.
-struct Entry(f64, usize);
-
-impl PartialEq for Entry {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
-}
-impl Eq for Entry {}
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Entry {
-    fn cmp(&self, other: &Self) -> Ordering {
-        other.0.total_cmp(&self.0).then(other.1.cmp(&self.1))
     }
 }
 

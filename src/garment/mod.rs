@@ -3,6 +3,7 @@
 //! mannequin and sewing into one cloth.
 
 pub mod body_frame;
+mod centre_seams;
 pub mod dress;
 pub mod dxf;
 pub mod dxf_write;
@@ -12,11 +13,13 @@ pub mod json;
 mod layers;
 pub mod mesh;
 mod mesh_boundary;
+mod mesh_graph;
 pub mod outline;
 mod over_the_top;
 pub mod pattern;
 pub mod preposition;
 mod relax;
+mod rows;
 pub mod shell;
 pub mod silhouette;
 pub mod svg;

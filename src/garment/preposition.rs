@@ -19,11 +19,12 @@
 
 use std::time::Instant;
 
+use super::centre_seams::{lay_centre_seams, CentreEdge};
 use super::layers::{layer_lifts, mean_edge_length};
 use super::mesh::GarmentMesh;
 use super::over_the_top::{column_tops, over_the_top, over_the_top_lifts};
 use super::relax::{push_out, relax};
-use super::shell::Shell;
+use super::rows::Rows;
 use super::silhouette::{Landmarks, Silhouettes};
 use super::{Pattern, PatternError, Side, P2};
 use crate::contact::MeshBody;
@@ -94,52 +95,12 @@ impl Figurine {
     }
 }
 
-/// One piece's horizontal interval in one row: (piece, X0, X1, group).
-#[derive(Clone, Copy)]
-struct Interval {
-    piece: usize,
-    x0: f64,
-    x1: f64,
-    group: usize,
-}
-
-/// A group's shell and the arc positions of its front and back centres.
-struct Group {
-    shell: Shell,
-    /// Widening factor of the shell (≥ 1).
-    k: f64,
-    /// Left coordinates of the front and back centres.
-    centre_s: [f64; 2],
-    front_arc: f64,
-    front_c: f64,
-    back_arc: f64,
-    back_c: f64,
-}
-
-impl Group {
-    /// Widens the shell by `k` and finds the arc positions of the centres on it.
-    fn finish(&mut self, k: f64) {
-        self.k = k;
-        if k > 1.0 {
-            self.shell = self.shell.scaled(k);
-        }
-        self.front_arc = self.shell.arc_at(self.centre_s[0], true);
-        self.back_arc = self.shell.arc_at(self.centre_s[1], false);
-    }
-}
-
-/// Largest change of a shell's widening factor per metre of height: the shell narrows or
-/// widens gradually, so that vertical edges are not sheared where the garment's width changes
-/// fast (an armhole).
-const WIDENING_RATE: f64 = 0.4;
+/// Distance (m) along a piece over which the displacement that lays a centre seam on the
+/// body's centre profile fades out.
+const CENTRE_FALLOFF: f64 = 0.12;
 
 /// Distance (m) along a piece over which a layer's lift falls from the layer gap to 0.
 const LAYER_RAMP: f64 = 0.03;
-
-struct Row {
-    intervals: Vec<Interval>,
-    groups: Vec<Group>,
-}
 
 /// Pre-positions the meshed `garment` (from `pattern`, expanded, every piece placed) around the
 /// body `skin` whose silhouettes and landmarks are given; returns the 3D vertex positions.
@@ -184,39 +145,8 @@ pub fn preposition(
             }
         }
     }
-    let (ymin, ymax) = fig_pos
-        .iter()
-        .fold((f64::MAX, f64::MIN), |(l, h), p| (l.min(p[1]), h.max(p[1])));
-    let (r0, r1) = (
-        sil.row(ymin).saturating_sub(1),
-        (sil.row(ymax) + 1).min(sil.nh - 1),
-    );
-    let mut rows: Vec<Row> = (r0..=r1)
-        .map(|i| build_row(i, garment, &figs, &fig_pos, sil, marks, dz))
-        .collect();
-    // above the lower chest (where armholes open the ring) the widening factor of one-group rows
-    // may only fall gradually going up: the shell does not shrink where the garment's width
-    // drops fast along an armhole, and the seams below, where the ring closes, still meet
-    let step = WIDENING_RATE * sil.cell;
-    let from = marks.waist + 0.25 * (marks.armpit - marks.waist);
-    let mut k: Vec<Option<f64>> = rows
-        .iter()
-        .map(|r| (r.groups.len() == 1).then(|| r.groups[0].k))
-        .collect();
-    for i in 1..k.len() {
-        if sil.h_of(r0 + i) < from {
-            continue;
-        }
-        if let (Some(a), Some(b)) = (k[i - 1], k[i]) {
-            k[i] = Some(b.max(a - step));
-        }
-    }
-    for (row, ki) in rows.iter_mut().zip(&k) {
-        for g in row.groups.iter_mut() {
-            let f = ki.unwrap_or(g.k);
-            g.finish(f);
-        }
-    }
+    let rows = Rows::new(garment, &figs, &fig_pos, sil, marks, dz);
+    let (r0, r1) = (rows.r0, rows.r1);
     let mut x = vec![Vec3::zeros(); n];
     for v in 0..n {
         let [fx, fy] = fig_pos[v];
@@ -225,17 +155,18 @@ pub fn preposition(
         let i1 = (i0 + 1).min(r1);
         let w = (t - i0 as f64).clamp(0.0, 1.0);
         let k = piece_of[v];
-        let a = place(&rows, i0 - r0, k, fx, &figs[k]);
-        let b = place(&rows, i1 - r0, k, fx, &figs[k]);
+        let a = rows.place(i0 - r0, k, fx, &figs[k]);
+        let b = rows.place(i1 - r0, k, fx, &figs[k]);
         let (s, d) = match (a, b) {
             (Some(a), Some(b)) => (a[0] * (1.0 - w) + b[0] * w, a[1] * (1.0 - w) + b[1] * w),
             (Some(a), None) | (None, Some(a)) => (a[0], a[1]),
             (None, None) => {
                 // no row of this piece here: search outwards
-                let found = (1..rows.len()).find_map(|o| {
-                    place(&rows, (i0 - r0).saturating_sub(o), k, fx, &figs[k]).or_else(|| {
-                        place(&rows, (i0 - r0 + o).min(rows.len() - 1), k, fx, &figs[k])
-                    })
+                let found = (1..rows.rows.len()).find_map(|o| {
+                    rows.place((i0 - r0).saturating_sub(o), k, fx, &figs[k])
+                        .or_else(|| {
+                            rows.place((i0 - r0 + o).min(rows.rows.len() - 1), k, fx, &figs[k])
+                        })
                 });
                 let p = found.ok_or_else(|| PatternError::Piece {
                     source_name: pattern.source.clone(),
@@ -265,6 +196,28 @@ pub fn preposition(
             *p += n * l;
         }
     }
+    // centre seams along the body's centre profile (a crotch seam passes under the body)
+    let centre = centre_edges(garment, &figs, &fig_pos, &piece_of, sil.cell);
+    if !centre.is_empty() {
+        // the body's centre line from the garment's top down to the crotch (or its bottom)
+        let col = sil.col(0.0);
+        let profile_rows: Vec<(f64, f64, f64)> = (r0..=r1)
+            .rev()
+            .skip_while(|&i| sil.depths(i, col).is_none())
+            .map_while(|i| sil.depths(i, col).map(|(f, b)| (sil.h_of(i), f, b)))
+            .collect();
+        let frame = &sil.frame;
+        lay_centre_seams(
+            garment,
+            &centre,
+            &profile_rows,
+            dz,
+            |p| frame.to_body(p)[1],
+            |h, d| frame.to_world(0.0, h, d),
+            CENTRE_FALLOFF,
+            &mut x,
+        );
+    }
     // push out what the shells did not keep clear (between rows, sharp features)
     let mut report = PrepositionReport {
         vertices: n,
@@ -288,6 +241,48 @@ pub fn preposition(
     report.max_strain = max;
     report.seconds = start.elapsed().as_secs_f64();
     Ok((x, report))
+}
+
+/// The edges of centre seams: seams joining two pieces of one figurine whose top end lies on
+/// the centre line (within two cells), each edge's vertices from its top end down.
+fn centre_edges(
+    garment: &GarmentMesh,
+    figs: &[Figurine],
+    fig_pos: &[P2],
+    piece_of: &[usize],
+    cell: f64,
+) -> Vec<CentreEdge> {
+    let mut out = Vec::new();
+    for seam in &garment.seams {
+        let (Some(&first), Some(&last)) = (seam.pairs.first(), seam.pairs.last()) else {
+            continue;
+        };
+        let (pa, pb) = (piece_of[first.0], piece_of[first.1]);
+        let side = figs[pa].side;
+        if pa == pb || figs[pb].side != side {
+            continue;
+        }
+        let down = fig_pos[first.0][1] >= fig_pos[last.0][1];
+        let top = if down { first } else { last };
+        if fig_pos[top.0][0].abs() > 2.0 * cell || fig_pos[top.1][0].abs() > 2.0 * cell {
+            continue;
+        }
+        let mut pairs = seam.pairs.clone();
+        if !down {
+            pairs.reverse();
+        }
+        for (piece, pick) in [(pa, 0), (pb, 1)] {
+            out.push(CentreEdge {
+                vertices: pairs
+                    .iter()
+                    .map(|p| if pick == 0 { p.0 } else { p.1 })
+                    .collect(),
+                side,
+                piece,
+            });
+        }
+    }
+    out
 }
 
 /// Unit vertex normals of the garment at `x` (area-weighted), each piece's turned away from
@@ -409,220 +404,4 @@ pub(super) fn s_of(side: Side, x: f64) -> f64 {
         Side::Front => x,
         Side::Back => -x,
     }
-}
-
-/// The (s, d) of a vertex of piece `k` at figurine X in row `r`, if the piece crosses the row.
-fn place(rows: &[Row], r: usize, k: usize, x: f64, fig: &Figurine) -> Option<[f64; 2]> {
-    let row = &rows[r];
-    let iv = row
-        .intervals
-        .iter()
-        .filter(|iv| iv.piece == k)
-        .min_by(|a, b| gap(a, x).total_cmp(&gap(b, x)))?;
-    let g = &row.groups[iv.group];
-    let sigma = match fig.side {
-        Side::Front => g.front_arc + (x - g.front_c),
-        Side::Back => g.back_arc + (x - g.back_c),
-    };
-    Some(g.shell.at(sigma))
-}
-
-fn gap(iv: &Interval, x: f64) -> f64 {
-    (iv.x0 - x).max(x - iv.x1).max(0.0)
-}
-
-/// The intervals, groups and (unwidened) shells of one silhouette row; each group's widening
-/// factor is the garment row's length over the shell's perimeter when above 1.
-fn build_row(
-    i: usize,
-    garment: &GarmentMesh,
-    figs: &[Figurine],
-    fig_pos: &[P2],
-    sil: &Silhouettes,
-    marks: &Landmarks,
-    dz: f64,
-) -> Row {
-    let h = sil.h_of(i);
-    // intervals of each piece's boundary polygon on the line y = h
-    let mut intervals = Vec::new();
-    for (k, pm) in garment.pieces.iter().enumerate() {
-        let b = &pm.boundary;
-        let mut xs = Vec::new();
-        for e in 0..b.len() {
-            let (p, q) = (fig_pos[b[e]], fig_pos[b[(e + 1) % b.len()]]);
-            if (p[1] <= h) != (q[1] <= h) {
-                xs.push(p[0] + (h - p[1]) / (q[1] - p[1]) * (q[0] - p[0]));
-            }
-        }
-        xs.sort_by(f64::total_cmp);
-        for pair in xs.chunks_exact(2) {
-            intervals.push(Interval {
-                piece: k,
-                x0: pair[0],
-                x1: pair[1],
-                group: usize::MAX,
-            });
-        }
-    }
-    // body sections: rows above the shoulders reuse the shoulder row; above the armpits the
-    // torso is cut to its width below the armpits (the arms are not dressed)
-    let body_row = i.min(sil.row(marks.shoulder));
-    let centre = sil.col(0.0);
-    let arm_cut = if sil.h_of(body_row) >= marks.armpit {
-        let below = sil.row(marks.chest);
-        sil.run_at(below, centre)
-            .map(|r| (sil.s_of(r.0) - sil.cell, sil.s_of(r.1) + sil.cell))
-    } else {
-        None
-    };
-    let mut sections: Vec<(f64, f64, Vec<[f64; 2]>)> = Vec::new();
-    for (j0, j1) in sil.runs(body_row) {
-        let mut pts = Vec::new();
-        for j in j0..=j1 {
-            let s = sil.s_of(j);
-            if let Some((lo, hi)) = arm_cut {
-                if s < lo || s > hi {
-                    continue;
-                }
-            }
-            if let Some((f, b)) = sil.depths(body_row, j) {
-                pts.push([s, f]);
-                pts.push([s, b]);
-            }
-        }
-        if !pts.is_empty() {
-            let (lo, hi) = pts
-                .iter()
-                .fold((f64::MAX, f64::MIN), |(l, h), p| (l.min(p[0]), h.max(p[0])));
-            sections.push((lo, hi, pts));
-        }
-    }
-    // union–find over intervals (first) and sections (after)
-    let ni = intervals.len();
-    let mut parent: Vec<usize> = (0..ni + sections.len()).collect();
-    fn find(p: &mut [usize], mut a: usize) -> usize {
-        while p[a] != a {
-            p[a] = p[p[a]];
-            a = p[a];
-        }
-        a
-    }
-    let span = |iv: &Interval| {
-        let side = figs[iv.piece].side;
-        let (a, b) = (s_of(side, iv.x0), s_of(side, iv.x1));
-        (a.min(b), a.max(b))
-    };
-    // intervals meet only through the body sections they cover: the crotch extensions of two
-    // trouser fronts overlap on the centre line, yet each front dresses its own leg
-    for a in 0..ni {
-        let (a0, a1) = span(&intervals[a]);
-        let mut joined = false;
-        for (k, sec) in sections.iter().enumerate() {
-            // a section joins when the interval covers its middle: an arm hanging beside a
-            // shirt's side does not widen the shirt's shell
-            let mid = 0.5 * (sec.0 + sec.1);
-            if a0 <= mid && mid <= a1 {
-                let (ra, rb) = (find(&mut parent, a), find(&mut parent, ni + k));
-                parent[ra] = rb;
-                joined = true;
-            }
-        }
-        if !joined && !sections.is_empty() {
-            // over no body section: join the nearest one
-            let mid = 0.5 * (a0 + a1);
-            let k = (0..sections.len())
-                .min_by(|&p, &q| {
-                    let dp = (sections[p].0 - mid).max(mid - sections[p].1);
-                    let dq = (sections[q].0 - mid).max(mid - sections[q].1);
-                    dp.total_cmp(&dq)
-                })
-                .unwrap_or(0);
-            let (ra, rb) = (find(&mut parent, a), find(&mut parent, ni + k));
-            parent[ra] = rb;
-        }
-    }
-    // one group per root holding intervals
-    let mut root_group: Vec<usize> = vec![usize::MAX; parent.len()];
-    let mut groups = Vec::new();
-    for a in 0..ni {
-        let r = find(&mut parent, a);
-        if root_group[r] == usize::MAX {
-            root_group[r] = groups.len();
-            groups.push(());
-        }
-        intervals[a].group = root_group[r];
-    }
-    let groups = (0..groups.len())
-        .map(|g| {
-            let members: Vec<&Interval> = intervals.iter().filter(|iv| iv.group == g).collect();
-            let mut pts: Vec<[f64; 2]> = Vec::new();
-            let (mut body_lo, mut body_hi) = (f64::MAX, f64::MIN);
-            for (k, sec) in sections.iter().enumerate() {
-                let r = find(&mut parent, ni + k);
-                if root_group[r] == g {
-                    pts.extend_from_slice(&sec.2);
-                    body_lo = body_lo.min(sec.0);
-                    body_hi = body_hi.max(sec.1);
-                }
-            }
-            if pts.is_empty() {
-                // no body at all (should not happen on a standing body): a flat slab
-                for iv in &members {
-                    let (a, b) = span(iv);
-                    pts.extend([[a, 0.05], [b, 0.05], [a, -0.05], [b, -0.05]]);
-                }
-            }
-            let Some(shell) = Shell::around(&pts, dz) else {
-                unreachable_shell()
-            };
-            // the length the row takes on the shell: the extent of each side's intervals (a
-            // dart's gap inside a piece is laid out too, to close when sewn)
-            let extent = |side: Side| {
-                let (lo, hi) = members
-                    .iter()
-                    .filter(|iv| figs[iv.piece].side == side)
-                    .fold((f64::MAX, f64::MIN), |(l, h), iv| {
-                        (l.min(iv.x0), h.max(iv.x1))
-                    });
-                (hi - lo).max(0.0)
-            };
-            let width = extent(Side::Front) + extent(Side::Back);
-            let k = (width / shell.perimeter()).max(1.0);
-            let centre = |side: Side| {
-                let (lo, hi) = members
-                    .iter()
-                    .filter(|iv| figs[iv.piece].side == side)
-                    .fold((f64::MAX, f64::MIN), |(l, h), iv| {
-                        (l.min(iv.x0), h.max(iv.x1))
-                    });
-                (lo <= hi).then_some(0.5 * (lo + hi))
-            };
-            let fc = centre(Side::Front);
-            let bc = centre(Side::Back);
-            // the garment row is centred on the body it dresses (a trouser leg on its leg);
-            // with no body under it, on its own pieces
-            let (fc_s, bc_s) = if body_lo <= body_hi {
-                let c = 0.5 * (body_lo + body_hi);
-                (c, c)
-            } else {
-                let f = fc.or(bc.map(|b| -b)).unwrap_or(0.0);
-                (f, bc.map(|b| -b).unwrap_or(f))
-            };
-            Group {
-                shell,
-                k,
-                centre_s: [fc_s, bc_s],
-                front_arc: 0.0,
-                back_arc: 0.0,
-                front_c: fc.unwrap_or(fc_s),
-                back_c: bc.unwrap_or(-bc_s),
-            }
-        })
-        .collect();
-    Row { intervals, groups }
-}
-
-/// A shell grown from at least one point always exists (24 points round it).
-fn unreachable_shell() -> ! {
-    unreachable!("a grown shell of a non-empty section has 24 points or more")
 }
