@@ -176,3 +176,58 @@ fn freesewing_garments_are_prepositioned_outside_the_body() {
         assert_eq!(inside, 0, "{name}: {inside} vertices inside the body");
     }
 }
+
+/// Regression: the pencil skirt's pre-positioned pieces intersected each other (502 pairs,
+/// counted with exact predicates, seam partners counted as one vertex):
+/// its rows were widened for the fabric's width without the darts' gaps, so front and back
+/// overlapped at the sides, and the two back halves' vent extensions lay on one surface.
+/// Rows now take each side's full extent and overlapping pieces are layered.
+#[test]
+fn prepositioned_shirt_and_skirt_do_not_intersect_themselves() {
+    for name in ["aaron", "penelope"] {
+        let pat = emilion::garment::read_garment(format!(
+            "{}/scripts/patterns/{name}.garment.json",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .unwrap();
+        let (g, x, _) = placed(&pat, 0.015);
+        let pts: Vec<[f64; 3]> = x.iter().map(|p| [p.x, p.y, p.z]).collect();
+        // seam partners count as one vertex (as the engine's self-collision welds them): an
+        // edge meeting a triangle at its partner's corner along a seam is not a crossing
+        let mut rep: Vec<usize> = (0..x.len()).collect();
+        for s in &g.seams {
+            for &(a, b) in &s.pairs {
+                let (ra, rb) = (root(&rep, a), root(&rep, b));
+                rep[ra.max(rb)] = ra.min(rb);
+            }
+        }
+        let r: Vec<usize> = (0..x.len()).map(|i| root(&rep, i)).collect();
+        let mut n = 0;
+        for (a, b) in support::intersections::unique_edges(&g.mesh.triangles) {
+            let (pa, pb) = (pts[a], pts[b]);
+            for t in &g.mesh.triangles {
+                if t.iter().any(|&k| r[k] == r[a] || r[k] == r[b]) {
+                    continue;
+                }
+                let [p0, p1, p2] = t.map(|k| pts[k]);
+                let apart = (0..3).any(|d| {
+                    pa[d].max(pb[d]) < p0[d].min(p1[d]).min(p2[d])
+                        || pa[d].min(pb[d]) > p0[d].max(p1[d]).max(p2[d])
+                });
+                if !apart
+                    && support::intersections::segment_triangle_intersect_exact(pa, pb, p0, p1, p2)
+                {
+                    n += 1;
+                }
+            }
+        }
+        assert_eq!(n, 0, "{name}: {n} intersecting edge–triangle pairs");
+    }
+}
+
+fn root(rep: &[usize], mut i: usize) -> usize {
+    while rep[i] != i {
+        i = rep[i];
+    }
+    i
+}

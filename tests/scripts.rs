@@ -105,6 +105,7 @@ fn other_scripts_run() {
             "self_fold",
             "mannequin_walk",
             "aaron",
+            "penelope",
         ]
         .contains(&name.as_str())
         {

@@ -178,18 +178,6 @@ pub(super) fn lay_centre_seams(
         [Some(f), Some(b)] => (0.5 * (f + b - level.total())).max(0.0),
         _ => 0.0,
     };
-    if std::env::var("PREPOS_DEBUG").is_ok() {
-        eprintln!(
-            "centre profile: total {:.3}, reach {:?}, extra {:.3}, rows {}",
-            level.total(),
-            reach,
-            extra,
-            rows.len()
-        );
-        for r in rows.iter().step_by(4) {
-            eprintln!("  h {:.3} f {:.3} b {:.3}", r.0, r.1, r.2);
-        }
-    }
     let Some(profile) = CentreProfile::new(rows, dz, extra) else {
         return;
     };

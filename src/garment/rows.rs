@@ -80,7 +80,7 @@ impl Rows {
             (sil.row(ymax) + 1).min(sil.nh - 1),
         );
         let mut rows: Vec<Row> = (r0..=r1)
-            .map(|i| build_row(i, garment, &figs, &fig_pos, sil, marks, dz))
+            .map(|i| build_row(i, garment, figs, fig_pos, sil, marks, dz))
             .collect();
         // above the lower chest (where armholes open the ring) the widening factor of one-group rows
         // may only fall gradually going up: the shell does not shrink where the garment's width

@@ -127,6 +127,22 @@ fn mode(c: &Option<Curve>) -> Option<ModeData> {
     })
 }
 
+/// The material law of a fabric file straight from its measurements (KES parameters or
+/// curves), before any calibration against the virtual rigs, and the fabric's linear
+/// parameters with its areal density, for simulations of garments in that fabric. Errors name
+/// the file.
+pub fn measured_fabric(
+    spec: &FabricSpec,
+) -> Result<(crate::cloth::FabricParameters, crate::cloth::MeasuredLaw), String> {
+    let model =
+        LawModel::new(&measurements(spec)).map_err(|e| format!("{}: {e}", display_path(spec)))?;
+    let params = crate::cloth::FabricParameters {
+        density: spec.density,
+        ..Default::default()
+    };
+    Ok((params, model.law()))
+}
+
 /// The measurements of a fabric file in the calibration's terms.
 pub fn measurements(spec: &FabricSpec) -> Measurements {
     let kes = |d: usize, p: KesParam| {

@@ -8,11 +8,13 @@ use std::sync::Arc;
 use rhai::{Engine, Map, INT};
 
 use super::convert::{num, rt_err, update_from_map, RResult};
+use super::kes::KesFabric;
 use super::{register, Fabric, SimHandle};
 use crate::body::Mannequin;
-use crate::cloth::SimulationParameters;
+use crate::cloth::{FabricParameters, MaterialLaw, SimulationParameters};
 use crate::garment::{dress, read_garment, read_pattern_json, read_pattern_svg, DressParameters};
 use crate::garment::{Pattern, PatternError, SvgOptions};
+use crate::kes::lab::measured_fabric;
 
 /// A pattern as a script handle (shared, never copied).
 #[derive(Debug, Clone)]
@@ -40,6 +42,42 @@ fn read_any(path: &str) -> Result<Pattern, PatternError> {
     }
 }
 
+/// `dress` for both kinds of fabric: a linear one, or a density with a measured law.
+fn dress_on_mannequin(
+    pattern: &Pattern,
+    fabric: FabricParameters,
+    law: Option<Arc<dyn MaterialLaw>>,
+    mut m: Map,
+) -> RResult<SimHandle> {
+    let dir = match m.remove("makehuman") {
+        Some(d) => d
+            .into_string()
+            .map_err(|t| rt_err(format!("`makehuman` must be a string, got {t}")))?
+            .into(),
+        None => std::env::var_os("EMILION_DATA")
+            .map_or_else(|| "../shared/data".into(), std::path::PathBuf::from)
+            .join("bodies/makehuman"),
+    };
+    let mut sp = SimulationParameters::default();
+    if let Some(dt) = m.remove("dt") {
+        sp.dt = num(&dt, "dt")?;
+    }
+    let mut params = DressParameters::default();
+    if let Some(e) = m.remove("edge_length") {
+        params.mesh.edge_length = num(&e, "edge_length")?;
+    }
+    if let Some(c) = m.remove("clearance") {
+        params.preposition.clearance = num(&c, "clearance")?;
+    }
+    let params: DressParameters = update_from_map(&params, &m, "dress")?;
+    let man = Mannequin::load_makehuman(&dir).map_err(|e| rt_err(e.to_string()))?;
+    let mut d = dress(pattern, fabric, &man, &params, sp).map_err(perr)?;
+    if let Some(law) = law {
+        d.simulation.model.set_law(law);
+    }
+    Ok(SimHandle::new(d.simulation))
+}
+
 /// Registers the garment functions.
 pub fn register(engine: &mut Engine) {
     engine.register_type_with_name::<PatternHandle>("Pattern");
@@ -62,28 +100,14 @@ pub fn register(engine: &mut Engine) {
     );
     register!(engine, "dress", ["pattern: Pattern", "fabric: Fabric", "options: Map", "Simulation"],
         "Meshes the pattern, pre-positions it around the MakeHuman mannequin at rest (no arrangement\npoints) and returns a simulation that sews it (seam threads shorten at `sewing_speed`, no\ngravity) and then drapes it, the mannequin as a collision body. Options: `makehuman` (dir,\ndefault `$EMILION_DATA/bodies/makehuman`), `dt` (s), and the `DressParameters` fields:\n`seam_stiffness` (N/m), `seam_max_force` (N), `sewing_speed` (m/s), `silhouette_cell` (m),\n`edge_length` (m, the mesh's target edge) and `clearance` (m, kept from the skin).",
-        |p: &mut PatternHandle, f: Fabric, mut m: Map| -> RResult<SimHandle> {
-            let dir = match m.remove("makehuman") {
-                Some(d) => d.into_string().map_err(|t| rt_err(format!("`makehuman` must be a string, got {t}")))?.into(),
-                None => std::env::var_os("EMILION_DATA")
-                    .map_or_else(|| "../shared/data".into(), std::path::PathBuf::from)
-                    .join("bodies/makehuman"),
-            };
-            let mut sp = SimulationParameters::default();
-            if let Some(dt) = m.remove("dt") {
-                sp.dt = num(&dt, "dt")?;
-            }
-            let mut params = DressParameters::default();
-            if let Some(e) = m.remove("edge_length") {
-                params.mesh.edge_length = num(&e, "edge_length")?;
-            }
-            if let Some(c) = m.remove("clearance") {
-                params.preposition.clearance = num(&c, "clearance")?;
-            }
-            let params: DressParameters = update_from_map(&params, &m, "dress")?;
-            let man = Mannequin::load_makehuman(&dir).map_err(|e| rt_err(e.to_string()))?;
-            let d = dress(&p.0, f.0, &man, &params, sp).map_err(perr)?;
-            Ok(SimHandle::new(d.simulation))
+        |p: &mut PatternHandle, f: Fabric, m: Map| -> RResult<SimHandle> {
+            dress_on_mannequin(&p.0, f.0, None, m)
+        });
+    register!(engine, "dress", ["pattern: Pattern", "fabric: KesFabric", "options: Map", "Simulation"],
+        "As `dress` with a fabric file (`kes_fabric`): the garment takes the fabric's areal density\nand its material law from its measurements (KES parameters or curves, uncalibrated).",
+        |p: &mut PatternHandle, f: KesFabric, m: Map| -> RResult<SimHandle> {
+            let (params, law) = measured_fabric(&f.0).map_err(rt_err)?;
+            dress_on_mannequin(&p.0, params, Some(Arc::new(law)), m)
         });
     register!(engine, "save_sheet", ["pattern: Pattern", "path: String", "()"],
         "Writes the pattern sheet (`.png` or `.svg`): the pieces side by side at 400 pixels per metre,\nnames, grain lines, notches, and each seam's two edges in its colour with its number.",
