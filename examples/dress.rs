@@ -69,9 +69,33 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let steps = sim.steps_for(seconds);
     let mut worst_inside = 0;
     for k in 0..steps {
+        let before = sim.state.x.clone();
         let st = sim.step()?;
+        if std::env::var("EVERY").is_ok() {
+            let (i, d) = sim
+                .state
+                .x
+                .iter()
+                .zip(&before)
+                .map(|(a, b)| (a - b).norm())
+                .enumerate()
+                .fold((0, 0.0), |w, (i, d)| if d > w.1 { (i, d) } else { w });
+            let jumped = sim
+                .state
+                .x
+                .iter()
+                .zip(&before)
+                .filter(|(a, b)| (*a - *b).norm() > 0.02)
+                .count();
+            println!(
+                "step {k}: largest move {:.1} mm at vertex {i} from {:.3?} to {:.3?}; {jumped} moved > 2 cm",
+                d * 1e3,
+                before[i].as_slice(),
+                sim.state.x[i].as_slice()
+            );
+        }
         worst_inside = worst_inside.max(st.penetrating);
-        if k % 24 == 0 || k + 1 == steps {
+        if k % 24 == 0 || k + 1 == steps || std::env::var("EVERY").is_ok() {
             let gap = sim
                 .sewing
                 .as_ref()

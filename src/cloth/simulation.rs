@@ -458,8 +458,19 @@ impl Simulation {
                 };
             }
         }
+        // while sewing, no particle moves faster than the sewing allows, even on a step whose
+        // solve did not converge
+        let cap = self
+            .sewing
+            .as_ref()
+            .filter(|s| s.sewing_at(self.state.time))
+            .map_or(f64::INFINITY, |s| s.max_speed);
         for i in 0..self.particle_count() {
             self.state.v[i] += self.dv[i];
+            let speed = self.state.v[i].norm();
+            if speed > cap {
+                self.state.v[i] *= cap / speed;
+            }
             self.state.x[i] += self.state.v[i] * h;
         }
         self.finish_constraints(h);

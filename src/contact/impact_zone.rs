@@ -44,8 +44,19 @@ pub fn rigid_motion(d: &mut [Vec3], zone: &[usize], x0: &[Vec3], inv_mass: &[f64
     let omega = inertia
         .pseudo_inverse(1e-9 * inertia.norm())
         .map_or(Vec3::zeros(), |inv| inv * l);
-    let omega = if omega.norm() > MAX_TURN {
-        omega * (MAX_TURN / omega.norm())
+    // nor so far that a vertex moves more, relative to the zone's centre, than the fastest
+    // one did: a large zone (a whole garment piece) turned by MAX_TURN would swing its far
+    // ends by decimetres in one step
+    let (r_max, rel_max) = zone.iter().fold((0.0f64, 0.0f64), |(r, m), &i| {
+        (r.max((x0[i] - c).norm()), m.max((d[i] - dc).norm()))
+    });
+    let limit = if r_max > 0.0 {
+        MAX_TURN.min(rel_max / r_max)
+    } else {
+        MAX_TURN
+    };
+    let omega = if omega.norm() > limit {
+        omega * (limit / omega.norm())
     } else {
         omega
     };
