@@ -1,4 +1,5 @@
-//! The garment scripts end to end on short runs: the A-shirt's and the pencil skirt's patterns
+//! The garment scripts end to end on short runs: the A-shirt's, the pencil skirt's and the
+//! trousers' patterns
 //! are read, meshed, pre-positioned and put in a sewing simulation (in fabrics from
 //! `kawabata/fabrics`) that steps, renders and writes its glTF. Sewing to closed seams is
 //! checked in tests/garment_sewing.rs.
@@ -47,4 +48,9 @@ fn aaron_script_dresses_the_mannequin_and_writes_its_outputs() {
 #[test]
 fn penelope_script_dresses_the_mannequin_and_writes_its_outputs() {
     run_garment_script("penelope");
+}
+
+#[test]
+fn paco_script_dresses_the_mannequin_and_writes_its_outputs() {
+    run_garment_script("paco");
 }

@@ -106,6 +106,7 @@ fn other_scripts_run() {
             "mannequin_walk",
             "aaron",
             "penelope",
+            "paco",
         ]
         .contains(&name.as_str())
         {

@@ -36,12 +36,34 @@ impl Group {
     fn finish(&mut self, k: f64) {
         self.k = k;
         if k > 1.0 {
-            self.shell = self.shell.scaled(k);
+            let c = self.shell.centroid();
+            let (lo, hi) = self.shell.s_range();
+            // a group dressing one leg widens away from the other leg: scaled about its
+            // innermost point, so that the two legs' shells never overlap
+            let inner = match self.centre_s[0] {
+                s if s > LEG_OFFSET => Some(lo),
+                s if s < -LEG_OFFSET => Some(hi),
+                _ => None,
+            };
+            match inner {
+                Some(s) => {
+                    let about = [s, c[1]];
+                    self.shell = self.shell.scaled_about(k, about);
+                    // the row's centres move with the shell (the same similarity)
+                    for c in self.centre_s.iter_mut() {
+                        *c = about[0] + k * (*c - about[0]);
+                    }
+                }
+                None => self.shell = self.shell.scaled(k),
+            }
         }
         self.front_arc = self.shell.arc_at(self.centre_s[0], true);
         self.back_arc = self.shell.arc_at(self.centre_s[1], false);
     }
 }
+
+/// A group whose body centre lies further than this (m) from the centre line dresses one leg.
+const LEG_OFFSET: f64 = 0.03;
 
 /// Largest change of a shell's widening factor per metre of height: the shell narrows or
 /// widens gradually, so that vertical edges are not sheared where the garment's width changes

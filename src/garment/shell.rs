@@ -80,11 +80,26 @@ impl Shell {
 
     /// The shell scaled by `k` about its vertex centroid.
     pub fn scaled(&self, k: f64) -> Shell {
+        self.scaled_about(k, self.centroid())
+    }
+
+    /// The vertex centroid of the shell.
+    pub fn centroid(&self) -> [f64; 2] {
         let n = self.pts.len() as f64;
-        let c = self
-            .pts
+        self.pts
             .iter()
-            .fold([0.0, 0.0], |a, p| [a[0] + p[0] / n, a[1] + p[1] / n]);
+            .fold([0.0, 0.0], |a, p| [a[0] + p[0] / n, a[1] + p[1] / n])
+    }
+
+    /// The smallest and largest left coordinate of the shell.
+    pub fn s_range(&self) -> (f64, f64) {
+        self.pts
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(l, h), p| (l.min(p[0]), h.max(p[0])))
+    }
+
+    /// The shell scaled by `k` about the point `c`.
+    pub fn scaled_about(&self, k: f64, c: [f64; 2]) -> Shell {
         let pts = self
             .pts
             .iter()
