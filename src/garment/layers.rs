@@ -46,7 +46,6 @@ pub(super) fn layer_lifts(
                 })
         })
         .collect();
-    let mut dist = vec![f64::INFINITY; n];
     for b in 1..garment.pieces.len() {
         for a in 0..b {
             if sides[a] != sides[b] || !boxes_overlap(&boxes[a], &boxes[b], margin) {
@@ -65,12 +64,11 @@ pub(super) fn layer_lifts(
             if sources.is_empty() {
                 continue;
             }
-            adjacency.distances(&sources, fig_pos, ramp, &mut dist);
+            let (dist, _) = adjacency.nearest(&sources, fig_pos, ramp);
             for v in range {
                 if dist[v] < ramp {
                     lift[v] += gap * (1.0 - dist[v] / ramp);
                 }
-                dist[v] = f64::INFINITY;
             }
         }
     }

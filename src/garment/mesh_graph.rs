@@ -13,6 +13,7 @@ pub(super) struct Adjacency {
 }
 
 impl Adjacency {
+    /// The adjacency of `triangles` over `n` vertices.
     pub(super) fn new(triangles: &[[usize; 3]], n: usize) -> Adjacency {
         let mut pairs: Vec<(usize, usize)> = triangles
             .iter()
@@ -35,31 +36,9 @@ impl Adjacency {
         }
     }
 
-    /// Shortest path lengths (in the figurine plane) from `sources` along mesh edges, written
-    /// into `dist` up to `limit` (farther vertices keep their value).
-    pub(super) fn distances(&self, sources: &[usize], pos: &[P2], limit: f64, dist: &mut [f64]) {
-        let mut heap = BinaryHeap::new();
-        for &s in sources {
-            dist[s] = 0.0;
-            heap.push(Entry(0.0, s));
-        }
-        while let Some(Entry(d, v)) = heap.pop() {
-            if d > dist[v] {
-                continue;
-            }
-            for &w in &self.next[self.start[v]..self.start[v + 1]] {
-                let e = (pos[v][0] - pos[w][0]).hypot(pos[v][1] - pos[w][1]);
-                let dw = d + e;
-                if dw < dist[w] && dw < limit {
-                    dist[w] = dw;
-                    heap.push(Entry(dw, w));
-                }
-            }
-        }
-    }
-
-    /// Like [`Adjacency::distances`] on fresh arrays, also giving each reached vertex its
-    /// nearest source (unreached vertices: distance infinite, nearest `usize::MAX`).
+    /// Shortest path lengths (in the 2D embedding `pos`) from `sources` along mesh edges, up
+    /// to `limit`, and each reached vertex's nearest source (unreached vertices: distance
+    /// infinite, nearest `usize::MAX`).
     pub(super) fn nearest(
         &self,
         sources: &[usize],
@@ -110,5 +89,27 @@ impl PartialOrd for Entry {
 impl Ord for Entry {
     fn cmp(&self, other: &Self) -> Ordering {
         other.0.total_cmp(&self.0).then(other.1.cmp(&self.1))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paths_run_along_edges_and_stop_at_the_limit() {
+        // a unit square split along its diagonal 0–2
+        let tris = [[0, 1, 2], [0, 2, 3]];
+        let pos = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        let adj = Adjacency::new(&tris, 4);
+        let (d, near) = adj.nearest(&[0], &pos, 10.0);
+        assert_eq!(d[1], 1.0);
+        assert!((d[2] - 2f64.sqrt()).abs() < 1e-15);
+        assert_eq!(near, vec![0; 4]);
+        let (d, near) = adj.nearest(&[1], &pos, 1.5);
+        assert!(
+            d[3].is_infinite() && near[3] == usize::MAX,
+            "1–0–3 and 1–2–3 are 2 long"
+        );
     }
 }
