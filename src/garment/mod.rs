@@ -9,6 +9,7 @@ pub mod dxf;
 pub mod dxf_write;
 pub mod error;
 pub mod expand;
+mod hierarchy;
 pub mod json;
 mod layers;
 pub mod mesh;

@@ -20,8 +20,10 @@
 use std::time::Instant;
 
 use super::centre_seams::{lay_centre_seams, CentreEdge};
+use super::hierarchy::interpolate;
 use super::layers::{layer_lifts, mean_edge_length};
 use super::mesh::GarmentMesh;
+use super::mesh::{mesh_pattern, MeshParameters};
 use super::over_the_top::{column_tops, over_the_top, over_the_top_lifts};
 use super::relax::{push_out, relax};
 use super::rows::Rows;
@@ -36,8 +38,12 @@ use crate::geometry::Vec3;
 pub struct PrepositionParameters {
     /// Distance kept between the garment and the skin (m), the seed's d_z.
     pub clearance: f64,
-    /// Relaxation sweeps after the mapping (0: none).
+    /// Relaxation sweeps after the mapping, on each level (0: none).
     pub relax_iterations: usize,
+    /// Levels of the multi-resolution relaxation: 1 relaxes the garment's own mesh only; each
+    /// further level first relaxes the pattern meshed with edges twice as long and carries its
+    /// displacement over (coarse levels stop at 6 cm edges).
+    pub levels: usize,
     /// Distance (m) by which a piece overlapping an earlier one on the same figurine is lifted
     /// off it (two layers, such as a skirt's vent extensions); 0 leaves overlaps as they are.
     pub layer_gap: f64,
@@ -48,6 +54,7 @@ impl Default for PrepositionParameters {
         PrepositionParameters {
             clearance: 0.012,
             relax_iterations: 60,
+            levels: 3,
             layer_gap: 0.01,
         }
     }
@@ -99,6 +106,9 @@ impl Figurine {
 /// body's centre profile fades out.
 const CENTRE_FALLOFF: f64 = 0.12;
 
+/// Longest mesh edge (m) of a coarse level of the multi-resolution relaxation.
+const COARSEST_EDGE: f64 = 0.06;
+
 /// Distance (m) along a piece over which a layer's lift falls from the layer gap to 0.
 const LAYER_RAMP: f64 = 0.03;
 
@@ -113,6 +123,27 @@ pub fn preposition(
     params: &PrepositionParameters,
 ) -> Result<(Vec<Vec3>, PrepositionReport), PatternError> {
     let start = Instant::now();
+    if !(1..=6).contains(&params.levels) {
+        return Err(PatternError::Parameter(format!(
+            "pre-positioning levels must be 1 to 6, got {}",
+            params.levels
+        )));
+    }
+    let (_, x, mut report) = solve(pattern, garment, sil, marks, skin, params)?;
+    report.seconds = start.elapsed().as_secs_f64();
+    Ok((x, report))
+}
+
+/// Maps `garment` onto the body and relaxes it (over `params.levels` levels); returns the
+/// mapped positions (before any relaxation), the relaxed ones and the report.
+fn solve(
+    pattern: &Pattern,
+    garment: &GarmentMesh,
+    sil: &Silhouettes,
+    marks: &Landmarks,
+    skin: &MeshBody,
+    params: &PrepositionParameters,
+) -> Result<(Vec<Vec3>, Vec<Vec3>, PrepositionReport), PatternError> {
     let dz = params.clearance;
     if !(dz.is_finite() && dz > 0.0) {
         return Err(PatternError::Parameter(format!(
@@ -226,6 +257,39 @@ pub fn preposition(
     let reach = 1.0;
     report.pushed_out = push_out(&mut x, skin, dz);
     (report.initial_mean_strain, report.initial_max_strain) = edge_strain(garment, &x);
+    let mapped = x.clone();
+    // coarse levels first: the displacement their relaxation made, carried over
+    let coarse_edge = 2.0 * mean_edge_length(garment);
+    if params.levels > 1 && coarse_edge <= COARSEST_EDGE {
+        let coarse = mesh_pattern(
+            pattern,
+            &MeshParameters {
+                edge_length: coarse_edge,
+                ..Default::default()
+            },
+        )?;
+        if coarse.pieces.len() == garment.pieces.len() {
+            let sub = PrepositionParameters {
+                levels: params.levels - 1,
+                ..*params
+            };
+            let (cm, cx, _) = solve(pattern, &coarse, sil, marks, skin, &sub)?;
+            let delta: Vec<Vec3> = cx.iter().zip(&cm).map(|(a, b)| a - b).collect();
+            let mut fine = interpolate(garment, &coarse, &delta);
+            // the two sides of a seam move together, keeping how the mapping matched them
+            for seam in &garment.seams {
+                for &(a, b) in &seam.pairs {
+                    let m = 0.5 * (fine[a] + fine[b]);
+                    fine[a] = m;
+                    fine[b] = m;
+                }
+            }
+            for (p, d) in x.iter_mut().zip(fine) {
+                *p += d;
+            }
+            push_out(&mut x, skin, dz);
+        }
+    }
     relax(garment, &mut x, skin, dz, params.relax_iterations);
     report.min_distance = f64::MAX;
     for p in &x {
@@ -239,8 +303,7 @@ pub fn preposition(
     let (mean, max) = edge_strain(garment, &x);
     report.mean_strain = mean;
     report.max_strain = max;
-    report.seconds = start.elapsed().as_secs_f64();
-    Ok((x, report))
+    Ok((mapped, x, report))
 }
 
 /// The edges of centre seams: seams joining two pieces of one figurine whose top end lies on
