@@ -193,10 +193,7 @@ pub(super) fn lay_centre_seams(
             let Some(&top) = e.vertices.first() else {
                 continue;
             };
-            let mut sigma = match e.side {
-                Side::Front => profile.arc_at_height(height_of(&x[top]), Side::Front),
-                Side::Back => profile.arc_at_height(height_of(&x[top]), Side::Back),
-            };
+            let mut sigma = profile.arc_at_height(height_of(&x[top]), e.side);
             let mut prev = top;
             for &v in &e.vertices {
                 let step = (flat[v][0] - flat[prev][0]).hypot(flat[v][1] - flat[prev][1]);
@@ -216,5 +213,37 @@ pub(super) fn lay_centre_seams(
                 x[v] += delta[nearest[v]] * (1.0 - dist[v] / falloff);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A box-shaped body 0.2 m deep and 0.2 m tall: the grown profile runs 0.2 m down the
+    /// front, round a quarter circle of radius dz, 0.2 m under, and up the back.
+    #[test]
+    fn profile_of_a_box_goes_down_under_and_up() {
+        let dz = 0.01;
+        let rows: Vec<(f64, f64, f64)> = (0..=20).map(|i| (-0.01 * i as f64, 0.1, -0.1)).collect();
+        let p = CentreProfile::new(&rows, dz, 0.0).unwrap();
+        let expected = 0.2 + 0.2 + 0.2 + std::f64::consts::PI * dz;
+        assert!(
+            (p.total() - expected).abs() < 0.01 * expected,
+            "{} vs {expected}",
+            p.total()
+        );
+        // starts at the top front, grown by dz, and reaches the bottom at the crossing
+        let [h, d] = p.at(0.0);
+        assert!(h.abs() < 1e-12 && (d - 0.11).abs() < 1e-3, "{h} {d}");
+        let front = p.arc_at_height(-0.1, Side::Front);
+        assert!((front - 0.1).abs() < 1e-3, "{front}");
+        let back = p.arc_at_height(-0.1, Side::Back);
+        assert!((p.total() - back - 0.1).abs() < 1e-3, "{back}");
+        let [h, _] = p.at(0.5 * p.total());
+        assert!((h + 0.21).abs() < 1e-3, "middle of the crossing at {h}");
+        // a crotch hanging lower lengthens the profile by twice the drop
+        let low = CentreProfile::new(&rows, dz, 0.03).unwrap();
+        assert!((low.total() - p.total() - 0.06).abs() < 1e-3);
     }
 }
