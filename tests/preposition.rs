@@ -266,3 +266,18 @@ fn coarse_levels_lower_the_residual_strain() {
         "mean strain {three} with three levels, {one} with one"
     );
 }
+
+#[test]
+fn bad_relaxation_levels_are_rejected_by_name() {
+    let b = body();
+    let pat = skirt(1.0, 0.5);
+    let g = mesh_pattern(&pat, &MeshParameters::default()).unwrap();
+    for levels in [0, 7] {
+        let params = PrepositionParameters {
+            levels,
+            ..Default::default()
+        };
+        let e = preposition(&pat, &g, &b.sil, &b.marks, &b.skin, &params).unwrap_err();
+        assert!(e.to_string().contains("levels"), "{e}");
+    }
+}

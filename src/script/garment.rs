@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use rhai::{Engine, Map, INT};
 
-use super::convert::{num, rt_err, update_from_map, RResult};
+use super::convert::{count, num, rt_err, update_from_map, RResult};
 use super::kes::KesFabric;
 use super::{register, Fabric, SimHandle};
 use crate::body::Mannequin;
@@ -69,6 +69,9 @@ fn dress_on_mannequin(
     if let Some(c) = m.remove("clearance") {
         params.preposition.clearance = num(&c, "clearance")?;
     }
+    if let Some(l) = m.remove("relax_levels") {
+        params.preposition.levels = count(&l, "relax_levels")?;
+    }
     let params: DressParameters = update_from_map(&params, &m, "dress")?;
     let man = Mannequin::load_makehuman(&dir).map_err(|e| rt_err(e.to_string()))?;
     let mut d = dress(pattern, fabric, &man, &params, sp).map_err(perr)?;
@@ -99,7 +102,7 @@ pub fn register(engine: &mut Engine) {
         |p: &mut PatternHandle| -> INT { p.0.seams.len() as INT }
     );
     register!(engine, "dress", ["pattern: Pattern", "fabric: Fabric", "options: Map", "Simulation"],
-        "Meshes the pattern, pre-positions it around the MakeHuman mannequin at rest (no arrangement\npoints) and returns a simulation that sews it (seam threads shorten at `sewing_speed`, no\ngravity) and then drapes it, the mannequin as a collision body. Options: `makehuman` (dir,\ndefault `$EMILION_DATA/bodies/makehuman`), `dt` (s), and the `DressParameters` fields:\n`seam_stiffness` (N/m), `seam_max_force` (N), `sewing_speed` (m/s), `silhouette_cell` (m),\n`edge_length` (m, the mesh's target edge) and `clearance` (m, kept from the skin).",
+        "Meshes the pattern, pre-positions it around the MakeHuman mannequin at rest (no arrangement\npoints) and returns a simulation that sews it (seam threads shorten at `sewing_speed`, no\ngravity) and then drapes it, the mannequin as a collision body. Options: `makehuman` (dir,\ndefault `$EMILION_DATA/bodies/makehuman`), `dt` (s), and the `DressParameters` fields:\n`seam_stiffness` (N/m), `seam_max_force` (N), `sewing_speed` (m/s), `silhouette_cell` (m),\n`edge_length` (m, the mesh's target edge), `clearance` (m, kept from the skin) and\n`relax_levels` (levels of the pre-positioning's multi-resolution relaxation, 1 to 6, default 3).",
         |p: &mut PatternHandle, f: Fabric, m: Map| -> RResult<SimHandle> {
             dress_on_mannequin(&p.0, f.0, None, m)
         });
