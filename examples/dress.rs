@@ -6,7 +6,10 @@
 //! `cargo run --release --example dress -- [aaron|penelope|paco] [seconds] [edge_m]`
 //!
 //! Environment knobs for experiments: `RELAX` (relaxation sweeps), `SEAM_FORCE` (N),
-//! `SELF` (`0` turns self-collision off), `SEW_G` (share of gravity while sewing).
+//! `SELF` (`0` turns self-collision off), `SEW_G` (share of gravity while sewing), `STITCH`
+//! (stitched seam stiffness, N/m); diagnostics: `DIAG` (per-seam gaps while running, the
+//! worst pair of each seam at the end, self-intersections by pair of pieces), `EVERY` (a line
+//! per step with the largest displacement).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
