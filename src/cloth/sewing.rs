@@ -43,6 +43,9 @@ pub struct Sewing {
     /// the stitched seam, stiffer than the threads that drew the edges together so that the
     /// fabric's tension across it opens no visible gap.
     pub stitched: (f64, f64),
+    /// Self-collision pass-through zones while sewing, one id per particle (0: none; empty:
+    /// no zones): pieces drawn together along a seam may pass through each other near it.
+    pub pass_through: Vec<u32>,
 }
 
 impl Sewing {
@@ -86,6 +89,7 @@ impl Sewing {
             max_time: 3.0,
             sewn_at: None,
             stitched: (10.0 * stiffness, 10.0 * max_force),
+            pass_through: Vec::new(),
         }
     }
 

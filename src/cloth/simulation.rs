@@ -337,6 +337,14 @@ impl Simulation {
         if let Some(sew) = &mut self.sewing {
             self.params.gravity = sew.update(&mut self.model, self.state.time, &self.state.x);
             self.contact.frictionless = sew.sewing_at(self.state.time);
+            if !sew.pass_through.is_empty() {
+                let zones: &[u32] = if sew.sewing_at(self.state.time) {
+                    &sew.pass_through
+                } else {
+                    &[]
+                };
+                self.contact.set_zones(zones);
+            }
         }
         self.x_save.copy_from_slice(&self.state.x);
         self.v_save.copy_from_slice(&self.state.v);

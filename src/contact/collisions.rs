@@ -186,7 +186,14 @@ impl Collisions {
         self.self_collision = Some(SelfCollision::new(triangles, rest));
     }
 
-    /// Declares cloth vertices sewn together (seam pairs), so self-collision leaves them be.
+    /// Sets self-collision's pass-through zones (see [`SelfCollision::set_zones`]).
+    pub fn set_zones(&mut self, zone: &[u32]) {
+        if let Some(sc) = self.self_collision.as_mut() {
+            sc.set_zones(zone);
+        }
+    }
+
+    /// Declares pairs of vertices sewn together (see [`SelfCollision::set_welds`]).
     pub fn set_welds(&mut self, n: usize, pairs: &[(usize, usize)]) {
         if let Some(sc) = self.self_collision.as_mut() {
             sc.set_welds(n, pairs);

@@ -69,6 +69,9 @@ pub struct SelfCollision {
     parent: Vec<u32>,
     /// Weld classes: vertices sewn together share a representative (empty: none welded).
     rep: Vec<u32>,
+    /// Pass-through zones (0: none): a vertex never collides with a triangle or edge whose
+    /// vertices all lie in its own zone (empty: no zones).
+    zone: Vec<u32>,
 }
 
 impl SelfCollision {
@@ -107,7 +110,15 @@ impl SelfCollision {
             moved: Vec::new(),
             parent: Vec::new(),
             rep: Vec::new(),
+            zone: Vec::new(),
         }
+    }
+
+    /// Sets the pass-through zones, one id per vertex (0: in none); an empty slice clears
+    /// them. Pieces being sewn along a seam may pass through each other near it.
+    pub fn set_zones(&mut self, zone: &[u32]) {
+        self.zone.clear();
+        self.zone.extend_from_slice(zone);
     }
 
     /// Declares pairs of vertices sewn together (seams): a welded vertex counts as shared with
@@ -174,6 +185,8 @@ impl SelfCollision {
         let (tri_hash, edge_hash, edge_boxes) = (&self.tri_hash, &self.edge_hash, &self.edge_boxes);
         let rep = &self.rep;
         let r = |i: u32| if rep.is_empty() { i } else { rep[i as usize] };
+        let zone = &self.zone;
+        let z = |i: u32| if zone.is_empty() { 0 } else { zone[i as usize] };
         let n = x0.len();
         let chunk = 512;
         let vf: Vec<Vec<(u32, u32)>> = (0..n.div_ceil(chunk))
@@ -187,9 +200,14 @@ impl SelfCollision {
                     tri_hash.query(&b, &mut buf);
                     let iu = i as u32;
                     let ri = r(iu);
+                    let zi = z(iu);
                     out.extend(
                         buf.iter()
-                            .filter(|&&t| !tris[t as usize].iter().any(|&k| r(k) == ri))
+                            .filter(|&&t| {
+                                let t = &tris[t as usize];
+                                !t.iter().any(|&k| r(k) == ri)
+                                    && !(zi != 0 && t.iter().all(|&k| z(k) == zi))
+                            })
                             .map(|&t| (iu, t)),
                     );
                 }
@@ -204,13 +222,15 @@ impl SelfCollision {
                 for e in c * chunk..((c + 1) * chunk).min(ne) {
                     edge_hash.query(&edge_boxes[e], &mut buf);
                     let [a, b] = edges[e];
+                    let za = if z(a) != 0 && z(a) == z(b) { z(a) } else { 0 };
                     let (a, b) = (r(a), r(b));
                     out.extend(
                         buf.iter()
                             .filter(|&&f| {
                                 let [p, q] = edges[f as usize];
+                                let zoned = za != 0 && z(p) == za && z(q) == za;
                                 let (p, q) = (r(p), r(q));
-                                f as usize > e && p != a && p != b && q != a && q != b
+                                f as usize > e && p != a && p != b && q != a && q != b && !zoned
                             })
                             .map(|&f| (e as u32, f)),
                     );

@@ -7,6 +7,7 @@
 use std::time::Instant;
 
 use super::mesh::{mesh_pattern, GarmentMesh, MeshParameters};
+use super::mesh_graph::Adjacency;
 use super::preposition::{preposition, PrepositionParameters, PrepositionReport};
 use super::{BodyFrame, Pattern, PatternError, Silhouettes};
 use crate::body::Mannequin;
@@ -154,6 +155,10 @@ pub fn dress(
     sim.contact.settings = params.contact;
     sim.contact.bodies.push(Body::mesh(skin));
     sim.contact.set_welds(x.len(), &pairs);
+    // where pre-positioning left the two pieces of a centre seam crossing each other (the
+    // crotch of trousers), they may pass through each other near it while sewn
+    let crossings = sim.contact.self_intersections(&x);
+    sewing.pass_through = pass_through_zones(pattern, &garment, &crossings, PASS_THROUGH);
     let report = DressReport {
         vertices: x.len(),
         triangles: garment.mesh.triangles.len(),
@@ -170,4 +175,63 @@ pub fn dress(
         simulation: sim,
         report,
     })
+}
+
+/// Distance (m, along the pieces) from a centre seam within which its two pieces may pass
+/// through each other while sewn.
+const PASS_THROUGH: f64 = 0.06;
+
+/// One pass-through zone per centre seam (a seam joining two pieces laid on the same side of
+/// the body: a crotch seam, a centre back) whose two pieces cross each other in `crossings`
+/// (intersecting edge–triangle pairs): the vertices of both pieces within `reach` of it.
+/// Empty when there is none.
+fn pass_through_zones(
+    pattern: &Pattern,
+    garment: &GarmentMesh,
+    crossings: &[([u32; 2], [u32; 3])],
+    reach: f64,
+) -> Vec<u32> {
+    let side = |k: usize| {
+        pattern
+            .pieces
+            .iter()
+            .find(|p| p.name == garment.pieces[k].name)
+            .and_then(|p| p.placement.as_ref())
+            .map(|pl| pl.side)
+    };
+    let piece_of = |v: usize| garment.pieces.iter().position(|p| p.vertices.contains(&v));
+    let adjacency = Adjacency::new(&garment.mesh.triangles, garment.flat.len());
+    let mut zone = vec![0u32; garment.flat.len()];
+    let mut any = false;
+    for (id, seam) in garment.seams.iter().enumerate() {
+        let Some(&(a, b)) = seam.pairs.first() else {
+            continue;
+        };
+        let (Some(pa), Some(pb)) = (piece_of(a), piece_of(b)) else {
+            continue;
+        };
+        if pa == pb || side(pa).is_none() || side(pa) != side(pb) {
+            continue;
+        }
+        let crossed = crossings.iter().any(|(e, t)| {
+            let (p, q) = (piece_of(e[0] as usize), piece_of(t[0] as usize));
+            (p, q) == (Some(pa), Some(pb)) || (p, q) == (Some(pb), Some(pa))
+        });
+        if !crossed {
+            continue;
+        }
+        let sources: Vec<usize> = seam.pairs.iter().flat_map(|&(a, b)| [a, b]).collect();
+        let (dist, _) = adjacency.nearest(&sources, &garment.flat, reach);
+        for (v, d) in dist.iter().enumerate() {
+            if d.is_finite() {
+                zone[v] = id as u32 + 1;
+                any = true;
+            }
+        }
+    }
+    if any {
+        zone
+    } else {
+        Vec::new()
+    }
 }
