@@ -205,8 +205,9 @@ impl SelfCollision {
                         buf.iter()
                             .filter(|&&t| {
                                 let t = &tris[t as usize];
-                                !t.iter().any(|&k| r(k) == ri)
-                                    && !(zi != 0 && t.iter().all(|&k| z(k) == zi))
+                                let shared = t.iter().any(|&k| r(k) == ri);
+                                let zoned = zi != 0 && t.iter().all(|&k| z(k) == zi);
+                                !(shared || zoned)
                             })
                             .map(|&t| (iu, t)),
                     );
