@@ -13,7 +13,7 @@ fn main() {
     sim.run_steps(20, |_, _| Ok(())).unwrap();
     let model = &sim.model;
     let mut asm = Assembly::new(model);
-    asm.a.enable_mirror32();
+    let mut ls = LineSolver::new(&mut asm.a, n, n);
     let inp = AssemblyInputs {
         dt: 1.0 / 120.0,
         gravity: Vec3::new(0.0, 0.0, -9.81),
@@ -40,7 +40,6 @@ fn main() {
             t.elapsed().as_secs_f64() * 1e3 / reps as f64
         );
         let fixed = vec![false; n * n];
-        let mut ls = LineSolver::new(&asm.a, n, n);
         let t = Instant::now();
         for _ in 0..reps {
             ls.factor(&asm.a, &fixed, None);

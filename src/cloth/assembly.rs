@@ -502,6 +502,10 @@ impl Assembly {
         let mirror = !self.a.values32.is_empty();
         let jacobi = self.jacobi;
         let values32 = SyncPtr(self.a.values32.as_mut_ptr());
+        let (perm32, perm_start) = match &mut self.a.permuted {
+            Some(pm) => (Some(SyncPtr(pm.values.as_mut_ptr())), &pm.row_start[..]),
+            None => (None, &[][..]),
+        };
         let (row_ptr, diag) = (&self.a.row_ptr, &self.a.diag);
         let (recs, rec_ptr, grecs, grec_ptr) =
             (&self.recs, &self.rec_ptr, &self.grecs, &self.grec_ptr);
@@ -536,6 +540,12 @@ impl Assembly {
                             if mirror {
                                 for s in row_ptr[i]..row_ptr[i + 1] {
                                     *values32.at(s) = Sym3f::from_upper(&*values.at(s));
+                                }
+                                if let Some(p) = perm32 {
+                                    let at = perm_start[i];
+                                    for s in row_ptr[i]..row_ptr[i + 1] {
+                                        *p.at(at + s - row_ptr[i]) = *values32.at(s);
+                                    }
                                 }
                             }
                             if jacobi {

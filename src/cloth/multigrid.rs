@@ -149,8 +149,9 @@ fn sampling(fine: (usize, usize), coarse: (usize, usize)) -> Vec<[(u32, f64); 4]
 }
 
 impl Multigrid {
-    /// Builds the hierarchy for `model`, which must be a grid cloth with matrix pattern `a`.
-    pub fn new(model: &ClothModel, a: &Bcsr3) -> Result<Self, ClothError> {
+    /// Builds the hierarchy for `model`, which must be a grid cloth with matrix pattern `a`
+    /// (whose single-precision mirrors the smoother reads: they are enabled here).
+    pub fn new(model: &ClothModel, a: &mut Bcsr3) -> Result<Self, ClothError> {
         let Some((nx, ny)) = model.grid else {
             return Err(ClothError::Parameter(
                 "the multigrid preconditioner needs a grid cloth".into(),
@@ -181,10 +182,9 @@ impl Multigrid {
             let mut cm = cm;
             cm.set_law(model.law.clone());
             let mut asm = Assembly::new(&cm);
-            asm.a.enable_mirror32();
             asm.jacobi = false;
             let nc = cx * cy;
-            let lines = LineSolver::new(&asm.a, cx, cy);
+            let lines = LineSolver::new(&mut asm.a, cx, cy);
             levels.last_mut().expect("level").to_fine = None;
             let to_fine = Transfer::new((fx, fy), (cx, cy));
             levels.last_mut().expect("level").to_fine = Some(to_fine);

@@ -149,13 +149,13 @@ impl Simulation {
         let mg = match (params.preconditioner, model.grid) {
             (PreconditionerKind::BlockJacobi, _) => None,
             (PreconditionerKind::Auto, Some((nx, ny))) if nx.min(ny) >= 16 => {
-                Some(Multigrid::new(&model, &asm.a)?)
+                Some(Multigrid::new(&model, &mut asm.a)?)
             }
             (PreconditionerKind::Auto, _) => None,
-            (PreconditionerKind::Multigrid, _) => Some(Multigrid::new(&model, &asm.a)?),
+            (PreconditionerKind::Multigrid, _) => Some(Multigrid::new(&model, &mut asm.a)?),
         };
         if mg.is_some() {
-            asm.a.enable_mirror32();
+            // the multigrid enabled the single-precision mirrors its smoother reads
             asm.jacobi = false;
         }
         let mut contact = Collisions::default();
