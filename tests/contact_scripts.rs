@@ -174,6 +174,19 @@ fn mannequin_walk_two_seconds_without_penetration() {
         inside.is_empty(),
         "skirt vertices inside the mannequin: {inside:?}"
     );
+    // regression: the gathered waistband followed the nearest body vertices, stacked several
+    // rim particles on one vertex and folded the rim through itself (265 intersections)
+    no_self_intersection(&skirt, "mannequin_walk skirt");
+    // no penetration at any step, as the solver's own count says
+    let csv = std::fs::read_to_string(dir.join("mannequin_walk_stats.csv")).unwrap();
+    let mut lines = csv.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = head.iter().position(|h| *h == "penetrating").unwrap();
+    let worst = lines
+        .filter_map(|l| l.split(',').nth(col).and_then(|v| v.parse::<u64>().ok()))
+        .max()
+        .unwrap();
+    assert_eq!(worst, 0, "vertices inside the mannequin at some step");
     // the skirt is worn: it stays around the hips, hem below them
     let (lo, hi) = emilion::geometry::mesh::bounds(&skirt.positions);
     assert!(

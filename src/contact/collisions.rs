@@ -11,6 +11,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::body::{Body, FrictionCoefficients, Proximity, Shape};
+use super::mesh_body::MeshBody;
+use super::primitives::closest_point_triangle;
 use super::self_collision::{SelfCollision, SelfCollisionReport};
 use super::ContactError;
 use crate::cloth::constraints::{Filter, ParticleFilter};
@@ -106,11 +108,13 @@ pub struct BodyPin {
     pub body: usize,
     /// The cloth particle.
     pub particle: usize,
-    /// The body vertex it follows.
-    pub vertex: usize,
-    /// Offset from the vertex when pinned (m).
+    /// The body surface point it follows: a triangle's vertices and barycentric weights.
+    pub vertices: [usize; 3],
+    /// Barycentric weights of the point in that triangle.
+    pub weights: [f64; 3],
+    /// Offset from the surface point when pinned (m).
     pub offset: Vec3,
-    /// The vertex normal when pinned.
+    /// The surface normal there when pinned.
     pub normal: Vec3,
     /// Optional snap onto the body: the offset eases to `gap` along the normal between
     /// times `from` and `to` (s): (gap, from, to).
@@ -118,7 +122,19 @@ pub struct BodyPin {
 }
 
 impl BodyPin {
-    /// Where the particle goes at time `t` when the vertex is at `p` with unit normal `n`.
+    /// The followed surface point and its unit normal (vertex normals interpolated) on `m`'s
+    /// current surface.
+    pub fn anchor(&self, m: &MeshBody) -> (Vec3, Vec3) {
+        let (mut p, mut n) = (Vec3::zeros(), Vec3::zeros());
+        for (&v, &w) in self.vertices.iter().zip(&self.weights) {
+            p += m.positions()[v] * w;
+            n += m.vertex_normal(v) * w;
+        }
+        (p, n / n.norm().max(1e-300))
+    }
+
+    /// Where the particle goes at time `t` when the surface point is at `p` with unit normal
+    /// `n`.
     pub fn target(&self, p: &Vec3, n: &Vec3, t: f64) -> Vec3 {
         let turn = nalgebra::Rotation3::rotation_between(&self.normal, n)
             .unwrap_or_else(nalgebra::Rotation3::identity);
@@ -200,9 +216,12 @@ impl Collisions {
         }
     }
 
-    /// Pins cloth `particles` (now at `x`) to mesh body `body`: each follows the body vertex
-    /// nearest to it in the body's rest pose (so that a waistband picks the waist, not a hand
-    /// swinging by), keeping its present offset from it, turned with the vertex normal. With
+    /// Pins cloth `particles` (now at `x`) to mesh body `body`: each follows the point of the
+    /// body's surface nearest to it in the rest pose (so that a waistband picks the waist, not a
+    /// hand swinging by), keeping its present offset from it, turned with the surface normal.
+    /// Neighbouring particles follow distinct, ordered surface points, so a gathered rim keeps
+    /// its order instead of folding through itself (following the nearest vertex, as before,
+    /// stacked several particles on one vertex and crossed the rim's edges). With
     /// `snap = Some((gap, from, to))` the offset eases between times `from` and `to` to `gap`
     /// along the vertex normal: the particles are drawn onto the body (a gathered waistband).
     pub fn pin_to_body(
@@ -239,23 +258,32 @@ impl Collisions {
                     x.len()
                 )));
             };
-            let (vertex, _) = m
-                .rest_positions()
+            let rest = m.rest_positions();
+            let (tri, weights, _) = m
+                .triangles()
                 .iter()
-                .enumerate()
-                .map(|(i, q)| (i, (q - xp).norm_squared()))
-                .min_by(|a, b| a.1.total_cmp(&b.1))
-                .expect("a mesh body has vertices");
-            let offset = xp - m.positions()[vertex];
-            self.pins.retain(|q| q.particle != p);
-            self.pins.push(BodyPin {
+                .map(|t| {
+                    let (q, w) = closest_point_triangle(*xp, rest[t[0]], rest[t[1]], rest[t[2]]);
+                    (*t, w, (q - xp).norm_squared())
+                })
+                .min_by(|a, b| a.2.total_cmp(&b.2))
+                .ok_or_else(|| {
+                    ContactError::Parameter(format!("body {body} (`{}`) has no triangles", b.name))
+                })?;
+            let mut pin = BodyPin {
                 body,
                 particle: p,
-                vertex,
-                offset,
-                normal: m.vertex_normal(vertex),
+                vertices: tri,
+                weights,
+                offset: Vec3::zeros(),
+                normal: Vec3::zeros(),
                 snap,
-            });
+            };
+            let (at, normal) = pin.anchor(m);
+            pin.offset = xp - at;
+            pin.normal = normal;
+            self.pins.retain(|q| q.particle != p);
+            self.pins.push(pin);
         }
         Ok(())
     }
@@ -282,11 +310,8 @@ impl Collisions {
         }
         for pin in &self.pins {
             if let Some(Shape::Mesh(m)) = self.bodies.get(pin.body).map(|b| &b.shape) {
-                let target = pin.target(
-                    &m.positions()[pin.vertex],
-                    &m.vertex_normal(pin.vertex),
-                    t + dt,
-                );
+                let (at, normal) = pin.anchor(m);
+                let target = pin.target(&at, &normal, t + dt);
                 filter.kind[pin.particle] = ParticleFilter::Fixed { target };
                 filter.any = true;
             }

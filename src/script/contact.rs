@@ -169,4 +169,17 @@ pub fn register(engine: &mut Engine) {
             m.insert("collision_ms".into(), Dynamic::from_float(st.collision_ms));
             Ok(m)
         });
+    register!(engine, "self_intersections", ["sim: Simulation", "Array"],
+        "The cloth's intersecting edge–triangle pairs now, each as #{edge: [a, b], triangle:\n[p, q, r]} (particle indices): where a garment passes through itself.",
+        |h: &mut SimHandle| -> RResult<Array> {
+            let mut sim = h.get_mut()?;
+            let x = sim.state.x.clone();
+            let ints = |v: &[u32]| v.iter().map(|&i| Dynamic::from_int(i as INT)).collect::<Array>();
+            Ok(sim.contact.self_intersections(&x).iter().map(|(e, t)| {
+                let mut m = Map::new();
+                m.insert("edge".into(), Dynamic::from_array(ints(e)));
+                m.insert("triangle".into(), Dynamic::from_array(ints(t)));
+                Dynamic::from_map(m)
+            }).collect())
+        });
 }
