@@ -4,6 +4,7 @@
 
 pub mod assembly;
 pub mod bcsr;
+pub mod choi_ko;
 pub mod constraints;
 pub mod elements;
 pub mod error;

@@ -4,12 +4,14 @@
 //! measurements and its fitting, damping from free oscillation, and the lab that runs it all.
 
 pub mod calibrate;
+pub mod compression;
 pub mod damping;
 pub mod error;
 pub mod fabric;
 pub mod fit;
 pub mod lab;
 pub mod parameters;
+pub(crate) mod quasi_static;
 pub mod rig;
 pub mod units;
 pub mod wang;

@@ -1,0 +1,136 @@
+//! Choi & Ko's immediate-buckling response of a compressed connection (Choi & Ko 2002, "Stable
+//! but Responsive Cloth"; the maths notes §4b). A connection of rest length L shorter than L is
+//! taken to have buckled at once into a circular arc of length L, so it stores bending energy
+//! instead of compressive strain energy. With λ = |x|/L and θ = sinc⁻¹(λ) (the arc's half
+//! angle), the force along the connection is
+//!
+//! f_b = k_b (2/L)² g(λ),   g(λ) = θ² / (cos θ − sinc θ),
+//!
+//! negative (the particles are pushed apart), from −12 k_b/L² at the onset to −π² (2/L)² k_b
+//! when the ends meet; k_b is the flexural rigidity of the width the connection stands for
+//! (N·m). θ is found exactly by a bracketed Newton iteration on sin θ − λθ = 0, not by a fitted
+//! polynomial, and near λ = 1 by the series of g.
+
+/// θ ∈ [0, π] with sin θ / θ = λ, for λ ∈ [0, 1].
+pub fn inverse_sinc(lambda: f64) -> f64 {
+    let lambda = lambda.clamp(0.0, 1.0);
+    if lambda >= 1.0 {
+        return 0.0;
+    }
+    if lambda <= 0.0 {
+        return std::f64::consts::PI;
+    }
+    // bracket: sinc decreases from 1 at 0 to 0 at π
+    let (mut lo, mut hi) = (0.0, std::f64::consts::PI);
+    let mut t = (6.0 * (1.0 - lambda)).sqrt().min(3.0);
+    for _ in 0..60 {
+        let h = t.sin() - lambda * t;
+        // h > 0 ⇔ sinc t > λ ⇔ t below the root
+        if h > 0.0 {
+            lo = t;
+        } else {
+            hi = t;
+        }
+        let dh = t.cos() - lambda;
+        let mut next = if dh != 0.0 { t - h / dh } else { f64::NAN };
+        if !(next > lo && next < hi) {
+            next = 0.5 * (lo + hi);
+        }
+        if (next - t).abs() <= 1e-15 * t.max(1e-300) {
+            return next;
+        }
+        t = next;
+    }
+    t
+}
+
+/// g(λ) = θ²/(cos θ − sinc θ) and dg/dλ, for λ ∈ [0, 1].
+pub fn buckling_g(lambda: f64) -> (f64, f64) {
+    let lambda = lambda.clamp(0.0, 1.0);
+    let u = 1.0 - lambda;
+    if u < 1e-6 {
+        // series about the onset: g = −3 − 9/5 u + O(u²)
+        return (-3.0 - 1.8 * u, 1.8);
+    }
+    let t = inverse_sinc(lambda);
+    let t2 = t * t;
+    // cos θ − sinc θ, by its series where the difference would cancel
+    let c_s = if t < 0.1 {
+        t2 * (-1.0 / 3.0 + t2 * (1.0 / 30.0 - t2 / 840.0))
+    } else {
+        t.cos() - t.sin() / t
+    };
+    let g = t2 / c_s;
+    // dg/dθ = (3θ(c − s) + θ² sin θ)/(c − s)², dλ/dθ = (c − s)/θ
+    let dg_dt = (3.0 * t * c_s + t2 * t.sin()) / (c_s * c_s);
+    let dl_dt = c_s / t;
+    (g, dg_dt / dl_dt)
+}
+
+/// Tension (N, negative: pushing apart) and its derivative with respect to the length (N/m)
+/// of a buckled connection of rest length `rest` and rigidity `k_b` (N·m) at length `len` ≤
+/// `rest`.
+pub fn buckling_force(k_b: f64, rest: f64, len: f64) -> (f64, f64) {
+    let (g, dg) = buckling_g(len / rest);
+    let c = k_b * 4.0 / (rest * rest);
+    (c * g, c * dg / rest)
+}
+
+/// Energy (J) stored by a buckled connection: the arc's bending energy ½ k_b κ² L with
+/// κ = 2θ/L.
+pub fn buckling_energy(k_b: f64, rest: f64, len: f64) -> f64 {
+    let t = inverse_sinc(len / rest);
+    let kappa = 2.0 * t / rest;
+    0.5 * k_b * kappa * kappa * rest
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn g_matches_the_exact_values_of_the_maths_notes() {
+        // maths notes §4b: exact g(λ)
+        let table = [
+            (1.0, -3.0),
+            (0.9, -3.193),
+            (0.8, -3.418),
+            (2.0 / std::f64::consts::PI, -3.875),
+            (0.5, -4.387),
+            (0.3, -5.513),
+            (0.1, -7.687),
+            (0.0, -std::f64::consts::PI.powi(2)),
+        ];
+        for (l, g) in table {
+            let (got, _) = buckling_g(l);
+            assert!((got - g).abs() < 1.5e-3, "g({l}) = {got}, expected {g}");
+        }
+    }
+
+    #[test]
+    fn derivative_and_energy_are_consistent() {
+        for l in [0.999_999_5, 0.99, 0.9, 0.7, 0.4, 0.15] {
+            let h = 1e-6;
+            let (_, d) = buckling_g(l);
+            let fd = (buckling_g(l + h).0 - buckling_g(l - h).0) / (2.0 * h);
+            assert!(
+                (d - fd).abs() < 1e-4 * fd.abs().max(1.0),
+                "λ {l}: {d} vs {fd}"
+            );
+            // the force is the derivative of the arc's energy with respect to the chord
+            let (kb, rest) = (2e-5, 0.01);
+            let len = l * rest;
+            let (f, _) = buckling_force(kb, rest, len);
+            let dl = 1e-9;
+            let de = (buckling_energy(kb, rest, len + dl) - buckling_energy(kb, rest, len - dl))
+                / (2.0 * dl);
+            assert!(
+                (f - de).abs() < 1e-4 * f.abs(),
+                "λ {l}: f {f} vs dE/dl {de}"
+            );
+        }
+        assert_eq!(inverse_sinc(1.0), 0.0);
+        let t = inverse_sinc(0.5);
+        assert!((t.sin() / t - 0.5).abs() < 1e-14);
+    }
+}
