@@ -38,6 +38,7 @@ fn strip(ends: StripEnds) -> Strip {
         width: 0.01,
         cells: 60,
         ends,
+        choi_ko: false,
     }
 }
 

@@ -84,6 +84,46 @@ pub fn buckling_energy(k_b: f64, rest: f64, len: f64) -> f64 {
     0.5 * k_b * kappa * kappa * rest
 }
 
+/// Below this λ the connection's force stays that of λ_min: g′ grows without bound as the
+/// ends meet (θ → π).
+pub const LAMBDA_MIN: f64 = 0.05;
+
+/// A buckled connection of rest length `rest` at length `len` < `rest`, standing for `area`
+/// (m²) of fabric whose bending law `bending(κ)` gives (M per width, dM/dκ, W per area): the
+/// arc of length `rest` through the two ends has curvature κ = 2θ/L and energy `area · W(κ)`,
+/// so the tension is `area · M(κ) dκ/dl`. Returns (tension N, negative; its derivative with
+/// respect to the length, the stable longitudinal part, ≥ 0, N/m; energy J). For a linear law
+/// M = Bκ this is Choi & Ko's `k_b (2/L)² g(λ)` with `k_b = area · B / L`.
+pub fn buckled_connection(
+    area: f64,
+    rest: f64,
+    len: f64,
+    bending: impl Fn(f64) -> (f64, f64, f64),
+) -> (f64, f64, f64) {
+    let lambda = (len / rest).clamp(LAMBDA_MIN, 1.0);
+    let theta = inverse_sinc(lambda);
+    let kappa = 2.0 * theta / rest;
+    let (g, dg) = buckling_g(lambda);
+    let (m, dm, w) = bending(kappa);
+    // M/κ (the secant rigidity), and h = κ dκ/dl = 4 g / L³, finite at the onset
+    let s = if kappa > 1e-9 { m / kappa } else { dm };
+    let h = 4.0 * g / rest.powi(3);
+    let tension = area * s * h;
+    // d/dl (S h) = S′ κ_l h + S h′ with κ_l = h/κ and S′ = (M′ − S)/κ
+    let curved = if kappa > 1e-6 {
+        (dm - s) * h * h / (kappa * kappa)
+    } else {
+        0.0
+    };
+    let dh = if len / rest > LAMBDA_MIN {
+        4.0 * dg / rest.powi(4)
+    } else {
+        0.0
+    };
+    let axial = (area * (curved + s * dh)).max(0.0);
+    (tension, axial, area * w)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -104,6 +144,33 @@ mod tests {
         for (l, g) in table {
             let (got, _) = buckling_g(l);
             assert!((got - g).abs() < 1.5e-3, "g({l}) = {got}, expected {g}");
+        }
+    }
+
+    #[test]
+    fn a_linear_law_gives_choi_and_kos_force() {
+        let (b, area, rest) = (3e-5, 0.01 * 0.02, 0.02);
+        let kb = area * b / rest;
+        for l in [0.99, 0.8, 0.5, 0.2] {
+            let len = l * rest;
+            let (t, k, e) =
+                buckled_connection(area, rest, len, |kap| (b * kap, b, 0.5 * b * kap * kap));
+            let (f, df) = buckling_force(kb, rest, len);
+            assert!((t - f).abs() < 1e-12 * f.abs() && (k - df).abs() < 1e-9 * df.abs());
+            assert!((e - buckling_energy(kb, rest, len)).abs() < 1e-12 * e.abs());
+            // a non-linear law: the tangent is the derivative of the tension
+            let law = |kap: f64| {
+                (
+                    b * kap + 0.1 * b * kap.powi(3),
+                    b + 0.3 * b * kap * kap,
+                    0.0,
+                )
+            };
+            let h = 1e-9;
+            let tp = buckled_connection(area, rest, len + h, law).0;
+            let tm = buckled_connection(area, rest, len - h, law).0;
+            let k = buckled_connection(area, rest, len, law).1;
+            assert!((k - (tp - tm) / (2.0 * h)).abs() < 1e-4 * k, "λ {l}");
         }
     }
 

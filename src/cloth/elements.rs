@@ -3,6 +3,7 @@
 //! triangles sharing an edge, for any triangle mesh). Each element evaluates its energy,
 //! forces and stiffness blocks from a `MaterialLaw`.
 
+use super::choi_ko;
 use super::material::{Direction, Friction, MaterialLaw};
 use crate::geometry::{Mat3, Vec3};
 
@@ -14,9 +15,21 @@ pub enum SpringKind {
     Stretch {
         /// cos² of the angle between the rest edge and the warp.
         warp_weight: f64,
+        /// Choi–Ko: compressed, the spring gives way to the buckling force of its length
+        /// of fabric instead of resisting with the compressive stiffness beyond it.
+        buckles: bool,
     },
     /// Shear, measured through the stretch of a quad diagonal: γ = 2ε.
     Shear,
+    /// Choi–Ko's interlaced connection between particles two apart along a grid line, or
+    /// between the opposite vertices of two triangles sharing an edge: slack in tension (the
+    /// stretch springs carry it), and compressed it takes the buckling force of an arc of its
+    /// rest length bent by the bending law (see [`super::choi_ko`]), capped near the onset by
+    /// the stretch law's compression so the force is continuous at the rest length.
+    Flexion {
+        /// Weight of the warp laws (cos² of the angle between the connection and the warp).
+        warp_weight: f64,
+    },
     /// A sewing thread between two pieces: a linear spring of `stiffness` (N/m) that pulls
     /// when longer than its rest length (which may be 0), at most with `max_force` (N), and is
     /// slack when shorter. Not a fabric law: `area` is unused.
@@ -83,27 +96,67 @@ impl Spring {
             };
         }
         let eps = len / self.rest - 1.0;
-        let (f, df, w) = match self.kind {
-            SpringKind::Stretch { warp_weight } => {
-                let (fu, dfu, wu) = law.tension(Direction::Warp, eps);
+        let stretch = |warp_weight: f64| {
+            let (fu, dfu, wu) = law.tension(Direction::Warp, eps);
+            let ww = 1.0 - warp_weight;
+            if ww == 0.0 {
+                (fu, dfu, wu)
+            } else {
+                let (fv, dfv, wv) = law.tension(Direction::Weft, eps);
+                (
+                    warp_weight * fu + ww * fv,
+                    warp_weight * dfu + ww * dfv,
+                    warp_weight * wu + ww * wv,
+                )
+            }
+        };
+        let buckled = |warp_weight: f64| {
+            choi_ko::buckled_connection(self.area, self.rest, len, |kappa| {
+                let (mu, dmu, wu) = law.bending(Direction::Warp, kappa);
                 let ww = 1.0 - warp_weight;
                 if ww == 0.0 {
-                    (fu, dfu, wu)
+                    (mu, dmu, wu)
                 } else {
-                    let (fv, dfv, wv) = law.tension(Direction::Weft, eps);
+                    let (mv, dmv, wv) = law.bending(Direction::Weft, kappa);
                     (
-                        warp_weight * fu + ww * fv,
-                        warp_weight * dfu + ww * dfv,
+                        warp_weight * mu + ww * mv,
+                        warp_weight * dmu + ww * dmv,
                         warp_weight * wu + ww * wv,
                     )
                 }
+            })
+        };
+        match self.kind {
+            SpringKind::Stretch {
+                warp_weight,
+                buckles: true,
+            } if eps < 0.0 => {
+                let (f, df, w) = stretch(warp_weight);
+                return self.softer_of(dir, (f, df, w), buckled(warp_weight));
             }
+            SpringKind::Flexion { warp_weight } => {
+                if eps >= 0.0 {
+                    return SpringEval {
+                        dir,
+                        tension: 0.0,
+                        axial: 0.0,
+                        transverse: 0.0,
+                        energy: 0.0,
+                    };
+                }
+                let (f, df, w) = stretch(warp_weight);
+                return self.softer_of(dir, (f, df, w), buckled(warp_weight));
+            }
+            _ => {}
+        }
+        let (f, df, w) = match self.kind {
+            SpringKind::Stretch { warp_weight, .. } => stretch(warp_weight),
             SpringKind::Shear => {
                 let (f, df, w) = law.shear(2.0 * eps);
                 (2.0 * f, 4.0 * df, w)
             }
             // returned above
-            SpringKind::Seam { .. } => (0.0, 0.0, 0.0),
+            SpringKind::Seam { .. } | SpringKind::Flexion { .. } => (0.0, 0.0, 0.0),
         };
         let tension = self.area * f / self.rest;
         let axial = self.area * df / (self.rest * self.rest);
@@ -123,6 +176,36 @@ impl Spring {
 }
 
 impl Spring {
+    /// The compressed spring's response, the smaller in magnitude of the stretch law's
+    /// compression `(F, dF/dε, W)` (per width) and the buckled arc's `(tension N, d/dL N/m,
+    /// energy J)`: stiff just below the rest length, then the buckling force.
+    #[inline]
+    fn softer_of(
+        &self,
+        dir: Vec3,
+        stretch: (f64, f64, f64),
+        buckled: (f64, f64, f64),
+    ) -> SpringEval {
+        let ts = self.area * stretch.0 / self.rest;
+        let (tension, axial, energy) = if ts >= buckled.0 {
+            (
+                ts,
+                self.area * stretch.1 / (self.rest * self.rest),
+                self.area * stretch.2,
+            )
+        } else {
+            buckled
+        };
+        SpringEval {
+            dir,
+            tension,
+            axial,
+            // compressed: the destabilising transverse term is left out (Choi & Ko)
+            transverse: 0.0,
+            energy,
+        }
+    }
+
     /// Adds internal friction to an evaluation `ev` of this spring at (`xa`, `xb`), updating
     /// and committing the friction state `st` = (coordinate, friction force per width). The
     /// coordinate is the strain for stretch springs and the shear angle 2ε for shear springs.
@@ -139,7 +222,7 @@ impl Spring {
         let gain = match self.kind {
             SpringKind::Stretch { .. } => 1.0,
             SpringKind::Shear => 2.0,
-            SpringKind::Seam { .. } => return,
+            SpringKind::Seam { .. } | SpringKind::Flexion { .. } => return,
         };
         let coord = gain * (len / self.rest - 1.0);
         if st[0].is_nan() {

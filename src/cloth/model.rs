@@ -32,6 +32,8 @@ pub struct ClothModel {
     pub law: Arc<dyn MaterialLaw>,
     /// Grid size (columns, rows) when built by [`ClothModel::grid`].
     pub grid: Option<(usize, usize)>,
+    /// Whether Choi & Ko's buckling model is on (see [`ClothModel::enable_choi_ko`]).
+    pub choi_ko: bool,
 }
 
 impl ClothModel {
@@ -55,8 +57,14 @@ impl ClothModel {
         let mut springs = Vec::new();
         let mut bend_lines = Vec::new();
         let mut shear_quads = Vec::new();
-        let warp = SpringKind::Stretch { warp_weight: 1.0 };
-        let weft = SpringKind::Stretch { warp_weight: 0.0 };
+        let warp = SpringKind::Stretch {
+            warp_weight: 1.0,
+            buckles: false,
+        };
+        let weft = SpringKind::Stretch {
+            warp_weight: 0.0,
+            buckles: false,
+        };
         for i in 0..ny {
             for j in 0..nx {
                 if j + 1 < nx {
@@ -117,6 +125,7 @@ impl ClothModel {
             law: Arc::new(fabric.linear_law()),
             fabric,
             grid: Some((nx, ny)),
+            choi_ko: false,
         })
     }
 
@@ -164,6 +173,7 @@ impl ClothModel {
                 area,
                 kind: SpringKind::Stretch {
                     warp_weight: du * du / l2,
+                    buckles: false,
                 },
             });
         }
@@ -205,7 +215,61 @@ impl ClothModel {
             law: Arc::new(fabric.linear_law()),
             fabric,
             grid: None,
+            choi_ko: false,
         })
+    }
+
+    /// Switches to Choi & Ko's buckling model: compressed stretch springs give way to the
+    /// buckling force of their fabric instead of resisting with their compressive stiffness,
+    /// and bending is carried by interlaced connections that buckle into arcs: between
+    /// particles two apart along each grid line (replacing the bending lines) or, on a
+    /// triangle mesh, between the opposite vertices of each pair of triangles sharing an edge
+    /// (replacing the hinges). Each connection stands for the fabric its element stood for, so
+    /// a linear law's bending energy at a given curvature is unchanged.
+    pub fn enable_choi_ko(&mut self) {
+        if self.choi_ko {
+            return;
+        }
+        for s in &mut self.springs {
+            if let SpringKind::Stretch { buckles, .. } = &mut s.kind {
+                *buckles = true;
+            }
+        }
+        let rest = &self.mesh.rest;
+        let dist = |p: usize, q: usize| {
+            let (du, dv) = (rest[q][0] - rest[p][0], rest[q][1] - rest[p][1]);
+            (
+                (du * du + dv * dv).sqrt(),
+                du * du / (du * du + dv * dv).max(1e-300),
+            )
+        };
+        for e in std::mem::take(&mut self.bend_lines) {
+            let [a, _, c] = e.nodes;
+            let (len, _) = dist(a, c);
+            self.springs.push(Spring {
+                a,
+                b: c,
+                rest: len,
+                area: e.area,
+                kind: SpringKind::Flexion {
+                    warp_weight: if e.dir == Direction::Warp { 1.0 } else { 0.0 },
+                },
+            });
+        }
+        for h in std::mem::take(&mut self.hinges) {
+            let [_, _, c, d] = h.nodes;
+            let (len, warp_weight) = dist(c, d);
+            if len > 0.0 {
+                self.springs.push(Spring {
+                    a: c,
+                    b: d,
+                    rest: len,
+                    area: h.area,
+                    kind: SpringKind::Flexion { warp_weight },
+                });
+            }
+        }
+        self.choi_ko = true;
     }
 
     /// Number of particles.
@@ -240,5 +304,55 @@ impl ClothModel {
             }
         }
         pairs
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Vec3;
+
+    #[test]
+    fn choi_ko_replaces_bending_lines_by_flexion_connections_of_the_same_fabric() {
+        let fabric = FabricParameters::default();
+        let mut m = ClothModel::grid(0.1, 0.05, 11, 6, fabric).unwrap();
+        let lines = m.bend_lines.clone();
+        let set = |m: &ClothModel| {
+            let mut p: Vec<(usize, usize)> = m
+                .coupled_pairs()
+                .into_iter()
+                .map(|(a, b)| (a.min(b), a.max(b)))
+                .collect();
+            p.sort_unstable();
+            p.dedup();
+            p
+        };
+        let pairs = set(&m);
+        m.enable_choi_ko();
+        assert!(m.bend_lines.is_empty() && m.choi_ko);
+        let flex: Vec<&Spring> = m
+            .springs
+            .iter()
+            .filter(|s| matches!(s.kind, SpringKind::Flexion { .. }))
+            .collect();
+        assert_eq!(flex.len(), lines.len());
+        // the matrix pattern keeps the same couplings (a–c of each line)
+        assert_eq!(set(&m), pairs);
+        // a flexion connection bent into an arc of curvature κ stores the energy the bending
+        // line stood for: area · ½ B κ² (linear law)
+        let law = m.law.clone();
+        let kappa = 20.0;
+        for (s, e) in flex.iter().zip(&lines) {
+            assert_eq!((s.a, s.b), (e.nodes[0], e.nodes[2]));
+            let theta = 0.5 * kappa * s.rest;
+            let chord = s.rest * theta.sin() / theta;
+            let ev = s.eval(&*law, &Vec3::zeros(), &Vec3::new(chord, 0.0, 0.0));
+            let (_, _, w) = law.bending(e.dir, kappa);
+            assert!((ev.energy / (e.area * w) - 1.0).abs() < 1e-9);
+            assert!(ev.tension < 0.0 && ev.transverse == 0.0);
+            // slack when stretched
+            let ev = s.eval(&*law, &Vec3::zeros(), &Vec3::new(1.01 * s.rest, 0.0, 0.0));
+            assert_eq!(ev.tension, 0.0);
+        }
     }
 }

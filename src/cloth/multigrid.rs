@@ -181,6 +181,9 @@ impl Multigrid {
             let cm = ClothModel::grid(w, h, cx, cy, model.fabric)?;
             let mut cm = cm;
             cm.set_law(model.law.clone());
+            if model.choi_ko {
+                cm.enable_choi_ko();
+            }
             let mut asm = Assembly::new(&cm);
             asm.jacobi = false;
             let nc = cx * cy;
