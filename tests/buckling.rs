@@ -169,3 +169,79 @@ fn choi_ko_force_is_stiffer_than_the_elastica_by_its_arc_kinematics() {
     // the maths notes: 20–30 % stiffer; more would be a bug in the force
     assert!(worst > 0.15 && worst < 0.32, "deviation {worst}");
 }
+
+/// Runs `scripts/buckle_square.rhai` with `sets` into a fresh folder; returns its printed
+/// report lines and the folder.
+fn buckle_square(tag: &str, sets: &[(&str, &str)]) -> (Vec<String>, std::path::PathBuf) {
+    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("buckling")
+        .join(tag);
+    let _ = std::fs::remove_dir_all(&out);
+    std::fs::create_dir_all(&out).unwrap();
+    let exe = env!("CARGO_BIN_EXE_emilion");
+    let mut cmd = std::process::Command::new(exe);
+    cmd.arg("run")
+        .arg(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scripts/buckle_square.rhai"
+        ))
+        .arg("--set")
+        .arg(format!("out={}", out.display()));
+    for (k, v) in sets {
+        cmd.arg("--set").arg(format!("{k}={v}"));
+    }
+    let o = cmd.output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let lines = String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .filter(|l| l.starts_with("buckle_square"))
+        .map(str::to_string)
+        .collect();
+    (lines, out.join("buckle_square"))
+}
+
+/// The number after `key` in a report line.
+fn field(line: &str, key: &str) -> f64 {
+    let rest = &line[line.find(key).unwrap_or_else(|| panic!("{key} in {line}")) + key.len()..];
+    rest.trim_start()
+        .split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-' || c == 'e'))
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap()
+}
+
+#[test]
+fn pushed_square_wrinkles_and_choi_ko_lowers_its_energy_deterministically() {
+    let (a, dir_a) = buckle_square("seed42a", &[("seed", "42")]);
+    let (b, dir_b) = buckle_square("seed42b", &[("seed", "42")]);
+    assert_eq!(a.len(), 2, "{a:?}");
+    // the same seed gives the same report (timings aside)
+    let strip = |l: &String| l[..l.find(" J,").unwrap()].to_string();
+    assert_eq!(
+        a.iter().map(strip).collect::<Vec<_>>(),
+        b.iter().map(strip).collect::<Vec<_>>()
+    );
+    for l in &a {
+        eprintln!("{l}");
+    }
+    let (none, ck) = (&a[0], &a[1]);
+    assert!(none.contains(" none:") && ck.contains(" choi_ko:"));
+    // Choi–Ko: at most 1 % of the springs compressed by more than 1 %, and wrinkles
+    assert!(field(ck, "compressed >1%:") / 3280.0 <= 0.01);
+    assert!(field(ck, "half-waves") >= 2.0);
+    // its spring energy at the end is lower than without a buckling model
+    assert!(
+        field(ck, "elastic") < field(none, "elastic"),
+        "{none}\n{ck}"
+    );
+    // the same seed gives bit-identical cloths
+    for m in ["none", "choi_ko"] {
+        let (p, q) = (
+            dir_a.join(format!("{m}.obj")),
+            dir_b.join(format!("{m}.obj")),
+        );
+        assert_eq!(std::fs::read(p).unwrap(), std::fs::read(q).unwrap(), "{m}");
+    }
+    assert!(dir_a.join("energy.png").exists() && dir_a.join("energy.csv").exists());
+}

@@ -94,7 +94,8 @@ fn tour_script() {
 fn other_scripts_run() {
     for p in script_paths() {
         let name = p.file_stem().unwrap().to_str().unwrap().to_string();
-        // the contact scripts run in tests/contact_scripts.rs, with their checks
+        // the contact scripts run in tests/contact_scripts.rs, the garments in
+        // tests/garment_scripts.rs and buckle_square in tests/buckling.rs, with their checks
         if [
             "hang",
             "drop",
@@ -107,6 +108,7 @@ fn other_scripts_run() {
             "aaron",
             "penelope",
             "paco",
+            "buckle_square",
         ]
         .contains(&name.as_str())
         {

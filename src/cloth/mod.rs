@@ -19,6 +19,7 @@ pub mod sewing;
 pub mod simulation;
 pub mod state;
 pub mod stats;
+pub mod wrinkles;
 
 pub use constraints::{Attachment, ContactHook, Filter, Floor, Trajectory};
 pub use error::ClothError;

@@ -189,6 +189,33 @@ pub fn register(engine: &mut Engine) {
             Ok(ClothHandle(Shared::new(m)))
         }
     );
+    register!(
+        engine,
+        "with_choi_ko",
+        ["cloth: Cloth", "Cloth"],
+        "A copy of the cloth with Choi & Ko's buckling model: compressed springs give way to the
+buckling force of their fabric, and bending is carried by interlaced connections (two apart
+along grid lines, or across each pair of triangles) that buckle into arcs.",
+        |c: &mut ClothHandle| -> RResult<ClothHandle> {
+            let mut m = (*c.0).clone();
+            m.enable_choi_ko();
+            Ok(ClothHandle(Shared::new(m)))
+        }
+    );
+    register!(
+        engine,
+        "perturbed",
+        ["cloth: Cloth", "amplitude: float", "seed: int", "Cloth"],
+        "A copy of the cloth whose particles are moved along z by seeded pseudo-random amounts,
+uniform in ±amplitude/2 (m): the imperfection that lets a flat cloth pushed in its plane buckle.
+The same seed gives bit-identical positions; another seed may flip the wrinkles.",
+        |c: &mut ClothHandle, a: Dynamic, seed: INT| -> RResult<ClothHandle> {
+            let a = num(&a, "amplitude")?;
+            let mut m = (*c.0).clone();
+            m.perturb(crate::geometry::Vec3::z(), a, seed as u64);
+            Ok(ClothHandle(Shared::new(m)))
+        }
+    );
     getter!(
         engine,
         "vertex_count",

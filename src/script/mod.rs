@@ -18,6 +18,7 @@ pub mod docs;
 pub mod fabric;
 pub mod garment;
 pub mod kes;
+pub mod measure;
 pub mod output;
 pub mod repl;
 pub mod run;
@@ -107,6 +108,7 @@ pub fn build_engine_with(limits: EngineLimits) -> Engine {
     contact::register(&mut engine);
     garment::register(&mut engine);
     output::register(&mut engine);
+    measure::register(&mut engine);
     kes::register(&mut engine);
     engine
 }
