@@ -20,10 +20,11 @@ pub fn inverse_sinc(lambda: f64) -> f64 {
     if lambda <= 0.0 {
         return std::f64::consts::PI;
     }
-    // bracket: sinc decreases from 1 at 0 to 0 at π
+    // bracket: sinc decreases from 1 at 0 to 0 at π; start from the small-angle root
+    // √(6(1 − λ)) (capped below π), safeguarded Newton
     let (mut lo, mut hi) = (0.0, std::f64::consts::PI);
     let mut t = (6.0 * (1.0 - lambda)).sqrt().min(3.0);
-    for _ in 0..60 {
+    for _ in 0..40 {
         let h = t.sin() - lambda * t;
         // h > 0 ⇔ sinc t > λ ⇔ t below the root
         if h > 0.0 {
@@ -36,7 +37,7 @@ pub fn inverse_sinc(lambda: f64) -> f64 {
         if !(next > lo && next < hi) {
             next = 0.5 * (lo + hi);
         }
-        if (next - t).abs() <= 1e-15 * t.max(1e-300) {
+        if (next - t).abs() <= 4.0 * f64::EPSILON * t {
             return next;
         }
         t = next;
@@ -44,13 +45,13 @@ pub fn inverse_sinc(lambda: f64) -> f64 {
     t
 }
 
-/// g(λ) = θ²/(cos θ − sinc θ) and dg/dλ, for λ ∈ [0, 1].
-pub fn buckling_g(lambda: f64) -> (f64, f64) {
+/// θ = sinc⁻¹(λ), g(λ) = θ²/(cos θ − sinc θ) and dg/dλ, for λ ∈ [0, 1].
+pub fn arc(lambda: f64) -> (f64, f64, f64) {
     let lambda = lambda.clamp(0.0, 1.0);
     let u = 1.0 - lambda;
     if u < 1e-6 {
-        // series about the onset: g = −3 − 9/5 u + O(u²)
-        return (-3.0 - 1.8 * u, 1.8);
+        // series about the onset: θ² = 6u + O(u²), g = −3 − 9/5 u + O(u²)
+        return ((6.0 * u).sqrt(), -3.0 - 1.8 * u, 1.8);
     }
     let t = inverse_sinc(lambda);
     let t2 = t * t;
@@ -64,7 +65,13 @@ pub fn buckling_g(lambda: f64) -> (f64, f64) {
     // dg/dθ = (3θ(c − s) + θ² sin θ)/(c − s)², dλ/dθ = (c − s)/θ
     let dg_dt = (3.0 * t * c_s + t2 * t.sin()) / (c_s * c_s);
     let dl_dt = c_s / t;
-    (g, dg_dt / dl_dt)
+    (t, g, dg_dt / dl_dt)
+}
+
+/// g(λ) = θ²/(cos θ − sinc θ) and dg/dλ, for λ ∈ [0, 1].
+pub fn buckling_g(lambda: f64) -> (f64, f64) {
+    let (_, g, dg) = arc(lambda);
+    (g, dg)
 }
 
 /// Tension (N, negative: pushing apart) and its derivative with respect to the length (N/m)
@@ -101,9 +108,8 @@ pub fn buckled_connection(
     bending: impl Fn(f64) -> (f64, f64, f64),
 ) -> (f64, f64, f64) {
     let lambda = (len / rest).clamp(LAMBDA_MIN, 1.0);
-    let theta = inverse_sinc(lambda);
+    let (theta, g, dg) = arc(lambda);
     let kappa = 2.0 * theta / rest;
-    let (g, dg) = buckling_g(lambda);
     let (m, dm, w) = bending(kappa);
     // M/κ (the secant rigidity), and h = κ dκ/dl = 4 g / L³, finite at the onset
     let s = if kappa > 1e-9 { m / kappa } else { dm };
