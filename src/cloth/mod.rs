@@ -5,6 +5,7 @@
 pub mod assembly;
 pub mod bcsr;
 pub mod choi_ko;
+pub mod compression_release;
 pub mod constraints;
 pub mod elements;
 pub mod error;

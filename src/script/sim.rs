@@ -262,6 +262,41 @@ pub fn register(engine: &mut Engine) {
             Ok(())
         }
     );
+    register!(
+        engine,
+        "compression_release",
+        ["sim: Simulation", "options: Map"],
+        "Turns on the seed report's compression-release buckling model (grid cloths): each step the
+most compressed springs' particles are sent to where their springs regain their rest length
+(three spheres' intersection) and held there. `#{strain: 0.01, hold_steps: 3, seed: 1}`: the
+compression that triggers a release, how long a particle is held, the seed of the random
+up/down choice on a flat cloth.",
+        |h: &mut SimHandle, m: Map| -> RResult<()> {
+            use crate::cloth::compression_release::{CompressionRelease, ReleaseOptions};
+            const KEYS: [&str; 3] = ["strain", "hold_steps", "seed"];
+            if let Some(k) = m.keys().find(|k| !KEYS.contains(&k.as_str())) {
+                return Err(rt_err(format!(
+                    "compression_release: unknown option `{k}` (known: {})",
+                    KEYS.join(", ")
+                )));
+            }
+            let mut o = ReleaseOptions::default();
+            if let Some(v) = m.get("strain") {
+                o.strain = finite(v, "strain")?;
+            }
+            if let Some(v) = m.get("hold_steps") {
+                o.hold_steps = count(v, "hold_steps")?.max(1) as u32;
+            }
+            if let Some(v) = m.get("seed") {
+                o.seed = v.as_int().map_err(|_| rt_err("`seed` must be an int"))? as u64;
+            }
+            let mut sim = h.get_mut()?;
+            let cr = CompressionRelease::new(&sim.model, o)
+                .ok_or_else(|| rt_err("compression_release needs a grid cloth"))?;
+            sim.add_hook(Box::new(cr));
+            Ok(())
+        }
+    );
 
     register!(
         engine,

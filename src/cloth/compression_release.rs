@@ -1,0 +1,287 @@
+//! The compression-release buckling model of the seed report (§5.4.4.1.2, Chen & Gagalowicz):
+//! cloth is not left compressed. Each step, the most compressed stretch springs of a grid cloth
+//! are found; the particle at the spring's end is sent to where its three springs (two along the
+//! compression, one across) all have their rest length again — an intersection of three
+//! spheres — and held there for a few steps through the solver's constraint filter (S, z), so
+//! the rest of the cloth follows by the dynamics. Of the two intersections, the one not in
+//! contact, then the nearer, then the more curved is chosen; a seeded random draw breaks the
+//! remaining ties (a flat cloth buckles up or down at random, reproducibly for one seed).
+
+use super::constraints::{ContactHook, Filter, ParticleFilter};
+use super::elements::SpringKind;
+use super::model::ClothModel;
+use crate::geometry::Vec3;
+
+/// Options of the model.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReleaseOptions {
+    /// Springs compressed by more than this strain are released (e.g. 0.01).
+    pub strain: f64,
+    /// Steps a released particle is held at its destination.
+    pub hold_steps: u32,
+    /// Seed of the random choice between two equally good destinations.
+    pub seed: u64,
+}
+
+impl Default for ReleaseOptions {
+    fn default() -> Self {
+        ReleaseOptions {
+            strain: 0.01,
+            hold_steps: 3,
+            seed: 1,
+        }
+    }
+}
+
+/// The two points at distances `r` from the centres `c` (three spheres), if they exist:
+/// `(q₊, q₋)`, mirror images through the centres' plane (`q₊` on the side of
+/// (c₁ − c₀) × (c₂ − c₀)). `None` when the spheres have no common point or the centres are
+/// collinear.
+pub fn three_spheres(c: [Vec3; 3], r: [f64; 3]) -> Option<(Vec3, Vec3)> {
+    let ex = c[1] - c[0];
+    let d = ex.norm();
+    if d <= 0.0 {
+        return None;
+    }
+    let ex = ex / d;
+    let a = c[2] - c[0];
+    let i = ex.dot(&a);
+    let ey = a - ex * i;
+    let j = ey.norm();
+    if j <= 1e-12 * d {
+        return None;
+    }
+    let ey = ey / j;
+    let ez = ex.cross(&ey);
+    let x = (r[0] * r[0] - r[1] * r[1] + d * d) / (2.0 * d);
+    let y = (r[0] * r[0] - r[2] * r[2] + i * i + j * j) / (2.0 * j) - i * x / j;
+    let z2 = r[0] * r[0] - x * x - y * y;
+    if z2.is_nan() || z2 < 0.0 {
+        return None;
+    }
+    let z = z2.sqrt();
+    let base = c[0] + ex * x + ey * y;
+    Some((base + ez * z, base - ez * z))
+}
+
+/// Curvature through three points (seed §5.4.4.1.2): the turning angle of the polyline over
+/// its mean segment length.
+pub fn curvature3(p1: &Vec3, p2: &Vec3, p3: &Vec3) -> f64 {
+    let (v1, v2) = (p2 - p1, p3 - p2);
+    let (l1, l2) = (v1.norm(), v2.norm());
+    if l1 <= 0.0 || l2 <= 0.0 {
+        return 0.0;
+    }
+    let c = (v1.dot(&v2) / (l1 * l2)).clamp(-1.0, 1.0);
+    2.0 * c.acos() / (l1 + l2)
+}
+
+/// The model's state: grid neighbours and rest lengths, and who is held where.
+#[derive(Debug, Clone)]
+pub struct CompressionRelease {
+    options: ReleaseOptions,
+    nx: usize,
+    ny: usize,
+    /// Rest spacing along x (warp) and y (weft).
+    rest: (f64, f64),
+    /// Stretch springs (a, b, rest).
+    springs: Vec<(usize, usize, f64)>,
+    /// Held particles: (particle, destination, steps left).
+    held: Vec<(usize, Vec3, u32)>,
+    /// Scratch: particle already used this step.
+    busy: Vec<bool>,
+    /// Scratch: compressed springs (strain, spring).
+    order: Vec<(f64, usize)>,
+    rng: u64,
+    /// Releases performed so far.
+    pub releases: u64,
+}
+
+impl CompressionRelease {
+    /// The model for a grid cloth; `None` for other meshes (not supported yet).
+    pub fn new(model: &ClothModel, options: ReleaseOptions) -> Option<Self> {
+        let (nx, ny) = model.grid?;
+        let r = &model.mesh.rest;
+        let rest = (r[1][0] - r[0][0], r[nx][1] - r[0][1]);
+        let springs = model
+            .springs
+            .iter()
+            .filter(|s| matches!(s.kind, SpringKind::Stretch { .. }))
+            .map(|s| (s.a, s.b, s.rest))
+            .collect();
+        Some(CompressionRelease {
+            options,
+            nx,
+            ny,
+            rest,
+            springs,
+            held: Vec::new(),
+            busy: vec![false; nx * ny],
+            order: Vec::new(),
+            rng: options.seed,
+            releases: 0,
+        })
+    }
+
+    fn random_bit(&mut self) -> bool {
+        // SplitMix64
+        self.rng = self.rng.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.rng;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        (z ^ (z >> 31)) & 1 == 1
+    }
+
+    /// Marks particle `m` and its eight grid neighbours busy.
+    fn occupy(&mut self, m: usize) {
+        let (i, j) = (m / self.nx, m % self.nx);
+        for di in -1i64..=1 {
+            for dj in -1i64..=1 {
+                let (ii, jj) = (i as i64 + di, j as i64 + dj);
+                if ii >= 0 && jj >= 0 && (ii as usize) < self.ny && (jj as usize) < self.nx {
+                    self.busy[ii as usize * self.nx + jj as usize] = true;
+                }
+            }
+        }
+    }
+
+    /// The destination that releases particle `m`'s springs along `along` (1 warp, nx weft),
+    /// or `None` at the border or without an intersection.
+    fn destination(&mut self, x: &[Vec3], m: usize, along: usize) -> Option<Vec3> {
+        let (i, j) = (m / self.nx, m % self.nx);
+        let warp = along == 1;
+        let inside_along = if warp {
+            j >= 1 && j + 1 < self.nx
+        } else {
+            i >= 1 && i + 1 < self.ny
+        };
+        if !inside_along {
+            return None;
+        }
+        let (r_along, r_across) = if warp {
+            (self.rest.0, self.rest.1)
+        } else {
+            (self.rest.1, self.rest.0)
+        };
+        // the neighbour across: the side whose spring is shorter (more compressed)
+        let across = if warp { self.nx } else { 1 };
+        let has_prev = if warp { i >= 1 } else { j >= 1 };
+        let has_next = if warp {
+            i + 1 < self.ny
+        } else {
+            j + 1 < self.nx
+        };
+        let side = match (has_prev, has_next) {
+            (true, true) => {
+                if (x[m - across] - x[m]).norm() <= (x[m + across] - x[m]).norm() {
+                    m - across
+                } else {
+                    m + across
+                }
+            }
+            (true, false) => m - across,
+            (false, true) => m + across,
+            (false, false) => return None,
+        };
+        let c = [x[m - along], x[m + along], x[side]];
+        let (qp, qm) = three_spheres(c, [r_along, r_along, r_across])?;
+        let (dp, dm) = ((qp - x[m]).norm(), (qm - x[m]).norm());
+        let tol = 1e-9 * r_along;
+        if (dp - dm).abs() > tol {
+            return Some(if dp < dm { qp } else { qm });
+        }
+        let (kp, km) = (curvature3(&c[0], &qp, &c[1]), curvature3(&c[0], &qm, &c[1]));
+        if (kp - km).abs() > 1e-9 * kp.abs().max(1.0) {
+            return Some(if kp > km { qp } else { qm });
+        }
+        Some(if self.random_bit() { qp } else { qm })
+    }
+}
+
+impl ContactHook for CompressionRelease {
+    fn constrain(&mut self, x: &[Vec3], _v: &[Vec3], _t: f64, _dt: f64, filter: &mut Filter) {
+        self.busy.fill(false);
+        // particles still held keep their destination
+        self.held.retain(|h| h.2 > 0);
+        let held = std::mem::take(&mut self.held);
+        for &(m, q, left) in &held {
+            if matches!(filter.kind[m], ParticleFilter::Free) {
+                filter.kind[m] = ParticleFilter::Fixed { target: q };
+                filter.any = true;
+                self.held.push((m, q, left - 1));
+                self.occupy(m);
+            }
+        }
+        // the most compressed springs first (ties by index: deterministic)
+        self.order.clear();
+        for (k, &(a, b, rest)) in self.springs.iter().enumerate() {
+            let strain = (x[b] - x[a]).norm() / rest - 1.0;
+            if strain < -self.options.strain {
+                self.order.push((strain, k));
+            }
+        }
+        self.order
+            .sort_unstable_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
+        let order = std::mem::take(&mut self.order);
+        for &(_, k) in &order {
+            let (a, b, _) = self.springs[k];
+            let along = if b - a == 1 { 1 } else { self.nx };
+            for m in [b, a] {
+                if self.busy[m] || !matches!(filter.kind[m], ParticleFilter::Free) {
+                    continue;
+                }
+                if let Some(q) = self.destination(x, m, along) {
+                    filter.kind[m] = ParticleFilter::Fixed { target: q };
+                    filter.any = true;
+                    self.held
+                        .push((m, q, self.options.hold_steps.saturating_sub(1)));
+                    self.occupy(m);
+                    self.releases += 1;
+                    break;
+                }
+            }
+        }
+        self.order = order;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn three_spheres_meet_where_each_distance_is_its_radius() {
+        let c = [
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.8, 0.1, 0.0),
+            Vec3::new(0.9, 1.0, 0.05),
+        ];
+        let r = [1.0, 1.0, 1.0];
+        let (p, q) = three_spheres(c, r).expect("they meet");
+        for s in [p, q] {
+            for k in 0..3 {
+                assert!(((s - c[k]).norm() - r[k]).abs() < 1e-12);
+            }
+        }
+        assert!((p - q).norm() > 0.1);
+        // too far apart: no common point
+        assert!(three_spheres([c[0], Vec3::new(3.0, 0.0, 0.0), c[2]], r).is_none());
+    }
+
+    #[test]
+    fn a_compressed_line_releases_out_of_its_plane() {
+        // three particles 0.8 apart on x with rest 1, a neighbour across at rest distance:
+        // the middle one goes up or down to sit at distance 1 from all three
+        let c = [
+            Vec3::new(-0.8, 0.0, 0.0),
+            Vec3::new(0.8, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        ];
+        let (p, q) = three_spheres(c, [1.0, 1.0, 1.0]).unwrap();
+        // x = 0, y = 0.18, z = ±√0.3276
+        let z = 0.3276f64.sqrt();
+        assert!((p - Vec3::new(0.0, 0.18, z)).norm() < 1e-12, "{p}");
+        assert!((q - Vec3::new(0.0, 0.18, -z)).norm() < 1e-12, "{q}");
+        assert!((curvature3(&c[0], &p, &c[1]) - curvature3(&c[0], &q, &c[1])).abs() < 1e-12);
+    }
+}
