@@ -173,6 +173,12 @@ fn choi_ko_force_is_stiffer_than_the_elastica_by_its_arc_kinematics() {
 /// Runs `scripts/buckle_square.rhai` with `sets` into a fresh folder; returns its printed
 /// report lines and the folder.
 fn buckle_square(tag: &str, sets: &[(&str, &str)]) -> (Vec<String>, std::path::PathBuf) {
+    run_script("buckle_square", tag, sets)
+}
+
+/// Runs `scripts/NAME.rhai` with `sets` into a fresh folder; returns the lines it printed
+/// that start with NAME, and its output folder.
+fn run_script(name: &str, tag: &str, sets: &[(&str, &str)]) -> (Vec<String>, std::path::PathBuf) {
     let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join("buckling")
         .join(tag);
@@ -181,9 +187,9 @@ fn buckle_square(tag: &str, sets: &[(&str, &str)]) -> (Vec<String>, std::path::P
     let exe = env!("CARGO_BIN_EXE_emilion");
     let mut cmd = std::process::Command::new(exe);
     cmd.arg("run")
-        .arg(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/scripts/buckle_square.rhai"
+        .arg(format!(
+            "{}/scripts/{name}.rhai",
+            env!("CARGO_MANIFEST_DIR")
         ))
         .arg("--set")
         .arg(format!("out={}", out.display()));
@@ -194,10 +200,10 @@ fn buckle_square(tag: &str, sets: &[(&str, &str)]) -> (Vec<String>, std::path::P
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let lines = String::from_utf8_lossy(&o.stdout)
         .lines()
-        .filter(|l| l.starts_with("buckle_square"))
+        .filter(|l| l.starts_with(name))
         .map(str::to_string)
         .collect();
-    (lines, out.join("buckle_square"))
+    (lines, out.join(name))
 }
 
 /// The number after `key` in a report line.
@@ -264,4 +270,26 @@ fn flat_pushed_square_stays_compressed_without_a_model_and_buckles_with_compress
     );
     // Choi–Ko alone does not leave the plane (reported, see the README)
     let _ = ck;
+}
+
+#[test]
+fn cloth_pushed_along_a_cylinder_is_released_by_compression_release() {
+    let (l, dir) = run_script("buckle_cylinder", "cylinder", &[]);
+    for x in &l {
+        eprintln!("{x}");
+    }
+    assert_eq!(l.len(), 3, "{l:?}");
+    let (none, rel) = (&l[0], &l[2]);
+    assert!(rel.contains(" release:"));
+    for x in &l {
+        assert_eq!(field(x, "inside"), 0.0, "{x}");
+    }
+    // compression release: at most 1 % of the springs compressed by more than 1 %, less
+    // spring energy at the end than without a model
+    assert!(field(rel, "compressed >1%:") / 3280.0 <= 0.01, "{rel}");
+    assert!(
+        field(rel, "elastic") < field(none, "elastic"),
+        "{none}\n{rel}"
+    );
+    assert!(dir.join("energy.png").exists() && dir.join("release_24.png").exists());
 }

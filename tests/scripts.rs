@@ -109,6 +109,7 @@ fn other_scripts_run() {
             "penelope",
             "paco",
             "buckle_square",
+            "buckle_cylinder",
         ]
         .contains(&name.as_str())
         {

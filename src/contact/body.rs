@@ -153,6 +153,61 @@ impl Body {
         ))
     }
 
+    /// A solid closed cylinder of `radius` and `length` centred at `center` along `axis`,
+    /// as a triangle mesh of `segments` facets around (flat caps).
+    pub fn cylinder(
+        center: Vec3,
+        axis: Vec3,
+        radius: f64,
+        length: f64,
+        segments: usize,
+    ) -> Result<Body, ContactError> {
+        let a = axis.norm();
+        if !(finite(&center)
+            && a.is_finite()
+            && a > 1e-12
+            && radius.is_finite()
+            && radius > 0.0
+            && length.is_finite()
+            && length > 0.0
+            && segments >= 3)
+        {
+            return Err(ContactError::Parameter(format!(
+                "cylinder: radius and length must be > 0, the axis non-zero, the centre finite and at least 3 segments; got radius {radius}, length {length}, axis {:?}, centre {:?}, {segments} segments",
+                axis.as_slice(),
+                center.as_slice()
+            )));
+        }
+        let w = axis / a;
+        let u = if w.x.abs() < 0.9 {
+            Vec3::x()
+        } else {
+            Vec3::y()
+        };
+        let u = (u - w * w.dot(&u)).normalize();
+        let v = w.cross(&u);
+        let mut p = Vec::with_capacity(2 * segments + 2);
+        for end in [-0.5, 0.5] {
+            for k in 0..segments {
+                let t = std::f64::consts::TAU * k as f64 / segments as f64;
+                p.push(center + w * (end * length) + (u * t.cos() + v * t.sin()) * radius);
+            }
+        }
+        let (c0, c1) = (p.len(), p.len() + 1);
+        p.push(center - w * (0.5 * length));
+        p.push(center + w * (0.5 * length));
+        let mut t = Vec::with_capacity(4 * segments);
+        for k in 0..segments {
+            let k1 = (k + 1) % segments;
+            // outward: counter-clockwise seen from outside
+            t.push([k, k1, segments + k1]);
+            t.push([k, segments + k1, segments + k]);
+            t.push([c0, k1, k]);
+            t.push([c1, segments + k, segments + k1]);
+        }
+        Ok(Body::mesh(MeshBody::new("cylinder", p, &t)?))
+    }
+
     /// A body of a triangle mesh.
     pub fn mesh(mesh: MeshBody) -> Body {
         let name = mesh.name.clone();

@@ -55,6 +55,11 @@ pub fn register(engine: &mut Engine) {
         |h: &mut SimHandle, p: Dynamic, n: Dynamic| -> RResult<INT> {
             add_body(h, Body::plane(v3(&p, "point")?, v3(&n, "normal")?))
         });
+    register!(engine, "add_cylinder", ["sim: Simulation", "center: Array", "axis: Array", "radius: float", "length: float", "int"],
+        "Adds a static solid cylinder (flat caps, 96 facets around) centred at `center` along\n`axis`; returns its body index.",
+        |h: &mut SimHandle, c: Dynamic, a: Dynamic, r: Dynamic, l: Dynamic| -> RResult<INT> {
+            add_body(h, Body::cylinder(v3(&c, "center")?, v3(&a, "axis")?, finite(&r, "radius")?, finite(&l, "length")?, 96))
+        });
     register!(engine, "add_obstacle", ["sim: Simulation", "path: String", "int"],
         "Adds a static triangle mesh read from an OBJ file (metres) as a body. Degenerate triangles\nare dropped; a non-manifold or inconsistently wound mesh is an error naming the edge.\nReturns its body index.",
         |h: &mut SimHandle, path: &str| -> RResult<INT> {
