@@ -15,9 +15,6 @@ pub enum SpringKind {
     Stretch {
         /// cos² of the angle between the rest edge and the warp.
         warp_weight: f64,
-        /// Choi–Ko: compressed, the spring gives way to the buckling force of its length
-        /// of fabric instead of resisting with the compressive stiffness beyond it.
-        buckles: bool,
     },
     /// Shear, measured through the stretch of a quad diagonal: γ = 2ε.
     Shear,
@@ -126,31 +123,21 @@ impl Spring {
                 }
             })
         };
-        match self.kind {
-            SpringKind::Stretch {
-                warp_weight,
-                buckles: true,
-            } if eps < 0.0 => {
-                let (f, df, w) = stretch(warp_weight);
-                return self.softer_of(dir, (f, df, w), buckled(warp_weight));
+        if let SpringKind::Flexion { warp_weight } = self.kind {
+            if eps >= 0.0 {
+                return SpringEval {
+                    dir,
+                    tension: 0.0,
+                    axial: 0.0,
+                    transverse: 0.0,
+                    energy: 0.0,
+                };
             }
-            SpringKind::Flexion { warp_weight } => {
-                if eps >= 0.0 {
-                    return SpringEval {
-                        dir,
-                        tension: 0.0,
-                        axial: 0.0,
-                        transverse: 0.0,
-                        energy: 0.0,
-                    };
-                }
-                let (f, df, w) = stretch(warp_weight);
-                return self.softer_of(dir, (f, df, w), buckled(warp_weight));
-            }
-            _ => {}
+            let (f, df, w) = stretch(warp_weight);
+            return self.softer_of(dir, (f, df, w), buckled(warp_weight));
         }
         let (f, df, w) = match self.kind {
-            SpringKind::Stretch { warp_weight, .. } => stretch(warp_weight),
+            SpringKind::Stretch { warp_weight } => stretch(warp_weight),
             SpringKind::Shear => {
                 let (f, df, w) = law.shear(2.0 * eps);
                 (2.0 * f, 4.0 * df, w)
