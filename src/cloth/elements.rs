@@ -93,34 +93,10 @@ impl Spring {
             };
         }
         let eps = len / self.rest - 1.0;
-        let stretch = |warp_weight: f64| {
-            let (fu, dfu, wu) = law.tension(Direction::Warp, eps);
-            let ww = 1.0 - warp_weight;
-            if ww == 0.0 {
-                (fu, dfu, wu)
-            } else {
-                let (fv, dfv, wv) = law.tension(Direction::Weft, eps);
-                (
-                    warp_weight * fu + ww * fv,
-                    warp_weight * dfu + ww * dfv,
-                    warp_weight * wu + ww * wv,
-                )
-            }
-        };
-        let buckled = |warp_weight: f64| {
+        let stretch = |w: f64| blend(w, |d| law.tension(d, eps));
+        let buckled = |w: f64| {
             choi_ko::buckled_connection(self.area, self.rest, len, |kappa| {
-                let (mu, dmu, wu) = law.bending(Direction::Warp, kappa);
-                let ww = 1.0 - warp_weight;
-                if ww == 0.0 {
-                    (mu, dmu, wu)
-                } else {
-                    let (mv, dmv, wv) = law.bending(Direction::Weft, kappa);
-                    (
-                        warp_weight * mu + ww * mv,
-                        warp_weight * dmu + ww * dmv,
-                        warp_weight * wu + ww * wv,
-                    )
-                }
+                blend(w, |d| law.bending(d, kappa))
             })
         };
         if let SpringKind::Flexion { warp_weight } = self.kind {
@@ -160,6 +136,19 @@ impl Spring {
             energy: self.area * w,
         }
     }
+}
+
+/// A law's (value, derivative, energy) blended between the warp and the weft:
+/// `w · warp + (1 − w) · weft`, the weft not asked when `w` is 1.
+#[inline]
+fn blend(w: f64, law: impl Fn(Direction) -> (f64, f64, f64)) -> (f64, f64, f64) {
+    let (fu, dfu, wu) = law(Direction::Warp);
+    let ww = 1.0 - w;
+    if ww == 0.0 {
+        return (fu, dfu, wu);
+    }
+    let (fv, dfv, wv) = law(Direction::Weft);
+    (w * fu + ww * fv, w * dfu + ww * dfv, w * wu + ww * wv)
 }
 
 impl Spring {
