@@ -171,6 +171,36 @@ fn negative_density_is_named() {
 }
 
 #[test]
+fn buckling_parameters_are_checked() {
+    for (name, src, what) in [
+        (
+            "bad_perturbed",
+            "let c = cloth_grid(0.5, 0.5, 5, 5, fabric());\nlet p = c.perturbed(-1.0, 3);\n",
+            "amplitude",
+        ),
+        (
+            "bad_compression",
+            "let s = simulation(cloth_grid(0.5, 0.5, 5, 5, fabric()));\nlet r = s.compression(1.0 / 0.0);\n",
+            "strain",
+        ),
+        (
+            "bad_release",
+            "let s = simulation(cloth_grid(0.5, 0.5, 5, 5, fabric()));\ns.compression_release(#{ strain: -0.1 });\n",
+            "strain",
+        ),
+        (
+            "bad_cylinder",
+            "let s = simulation(cloth_grid(0.5, 0.5, 5, 5, fabric()));\ns.add_cylinder([0.0, 0.0, 0.0], [0.0, 0.0, 0.0], 0.1, 1.0);\n",
+            "axis",
+        ),
+    ] {
+        let p = write_script(name, src);
+        let text = run_file(&p, &[]).expect_err(name).to_string();
+        assert!(text.contains(what) && text.contains(":2:"), "{name}: {text}");
+    }
+}
+
+#[test]
 fn set_values_are_typed() {
     let p = write_script(
         "sets",

@@ -53,6 +53,15 @@ pub fn finite(d: &Dynamic, what: &str) -> RResult<f64> {
     }
 }
 
+/// A finite number ≥ 0 (else an error naming `what`).
+pub fn non_negative(d: &Dynamic, what: &str) -> RResult<f64> {
+    let v = finite(d, what)?;
+    if v < 0.0 {
+        return Err(rt_err(format!("`{what}` must be ≥ 0, got {v}")));
+    }
+    Ok(v)
+}
+
 /// A non-negative integer (counts, indices).
 pub fn count(d: &Dynamic, what: &str) -> RResult<usize> {
     match d.clone().try_cast::<INT>() {

@@ -210,7 +210,7 @@ along grid lines, or across each pair of triangles) that buckle into arcs.",
 uniform in ±amplitude/2 (m): the imperfection that lets a flat cloth pushed in its plane buckle.
 The same seed gives bit-identical positions; another seed may flip the wrinkles.",
         |c: &mut ClothHandle, a: Dynamic, seed: INT| -> RResult<ClothHandle> {
-            let a = num(&a, "amplitude")?;
+            let a = super::convert::non_negative(&a, "amplitude")?;
             let mut m = (*c.0).clone();
             m.perturb(crate::geometry::Vec3::z(), a, seed as u64);
             Ok(ClothHandle(Shared::new(m)))

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use rhai::{Array, Dynamic, Engine, Map, INT};
 
-use super::convert::{finite, index, num, rt_err, RResult};
+use super::convert::{finite, index, non_negative, rt_err, RResult};
 use super::{register, SimHandle};
 use crate::cloth::wrinkles::{compressed_springs, wrinkles_along};
 use crate::geometry::Vec3;
@@ -28,7 +28,7 @@ pub fn register(engine: &mut Engine) {
     register!(engine, "compression", ["sim: Simulation", "strain: float", "Map"],
         "Stretch springs compressed by more than `strain` (e.g. 0.01) now: #{springs, compressed,\nfraction}. A cloth without a buckling model pushed in its plane stays compressed.",
         |h: &mut SimHandle, strain: Dynamic| -> RResult<Map> {
-            let strain = num(&strain, "strain")?;
+            let strain = non_negative(&strain, "strain")?;
             let sim = h.get()?;
             let c = compressed_springs(&sim.model, &sim.state.x, strain);
             let mut m = Map::new();
@@ -40,7 +40,7 @@ pub fn register(engine: &mut Engine) {
     register!(engine, "wrinkles", ["sim: Simulation", "line: Array", "threshold: float", "Map"],
         "Wrinkles along the particles `line` (in order), heights along z: #{half_waves, wavelength\n(m, twice the line's span over the half-waves), amplitude (m)}. Deviations from the mean\nheight smaller than `threshold` (m) do not count.",
         |h: &mut SimHandle, line: Array, threshold: Dynamic| -> RResult<Map> {
-            let threshold = num(&threshold, "threshold")?;
+            let threshold = non_negative(&threshold, "threshold")?;
             let sim = h.get()?;
             let n = sim.state.x.len();
             let ids = line

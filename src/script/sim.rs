@@ -282,7 +282,7 @@ up/down choice on a flat cloth.",
             }
             let mut o = ReleaseOptions::default();
             if let Some(v) = m.get("strain") {
-                o.strain = finite(v, "strain")?;
+                o.strain = super::convert::non_negative(v, "strain")?;
             }
             if let Some(v) = m.get("hold_steps") {
                 o.hold_steps = count(v, "hold_steps")?.max(1) as u32;
