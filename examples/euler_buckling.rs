@@ -39,7 +39,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         width: 0.01,
         cells: 60,
         ends: StripEnds::Pinned,
-        choi_ko: false,
     };
     let pcr = strip.euler_load(b);
     let path = strip.compress(b, 0.6, 120)?;

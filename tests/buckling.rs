@@ -38,7 +38,6 @@ fn strip(ends: StripEnds) -> Strip {
         width: 0.01,
         cells: 60,
         ends,
-        choi_ko: false,
     }
 }
 

@@ -35,8 +35,6 @@ pub struct Strip {
     pub cells: usize,
     /// Support.
     pub ends: StripEnds,
-    /// Whether the strip's model uses Choi & Ko's buckling connections.
-    pub choi_ko: bool,
 }
 
 /// One equilibrium of the strip.
@@ -96,9 +94,6 @@ impl Strip {
         };
         let mut model = ClothModel::grid(d * (na - 1) as f64, self.width, na, 2, fabric)?;
         model.set_law(self.law.clone());
-        if self.choi_ko {
-            model.enable_choi_ko();
-        }
         let mut qs = QuasiStatic::new(model, Vec3::zeros());
         qs.filter.any = true;
         Ok(Rig {
