@@ -292,3 +292,26 @@ fn cloth_pushed_along_a_cylinder_is_released_by_compression_release() {
     );
     assert!(dir.join("energy.png").exists() && dir.join("release_24.png").exists());
 }
+
+/// The wrinkles of a sheet stretched along x and compressed along y: their wavelength follows
+/// the tension-set scaling λ = 2π (B L²/(π² T))^(1/4) of Cerda & Mahadevan, within the
+/// quantisation of a whole number of half-waves between the held borders.
+#[test]
+fn wrinkle_wavelength_grows_as_the_fourth_root_of_bending_rigidity() {
+    for model in ["release", "none"] {
+        let (l, dir) = run_script("wrinkle_wavelength", model, &[("model", model)]);
+        for x in &l {
+            eprintln!("{x}");
+        }
+        assert_eq!(l.len(), 3, "{l:?}");
+        let lambda: Vec<f64> = l.iter().map(|x| field(x, ", wavelength")).collect();
+        let predicted: Vec<f64> = l.iter().map(|x| field(x, "predicted")).collect();
+        for (m, p) in lambda.iter().zip(&predicted) {
+            assert!((m / p - 1.0).abs() < 0.25, "{model}: λ {m} m against {p} m");
+        }
+        // B grows 16-fold from the first run to the last: λ should double
+        let slope = (lambda[2] / lambda[0]).ln() / 16f64.ln();
+        assert!((slope - 0.25).abs() < 0.06, "{model}: λ ∝ B^{slope}");
+        assert!(dir.join(format!("{model}.png")).exists());
+    }
+}

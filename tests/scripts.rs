@@ -189,6 +189,16 @@ fn buckling_parameters_are_checked() {
             "strain",
         ),
         (
+            "bad_prestrain",
+            "let c = cloth_grid(0.5, 0.5, 5, 5, fabric());\nlet p = c.prestrained(0.05, -1.5);\n",
+            "strain_y",
+        ),
+        (
+            "bad_prestrain_nan",
+            "let c = cloth_grid(0.5, 0.5, 5, 5, fabric());\nlet p = c.prestrained(0.0 / 0.0, 0.0);\n",
+            "strain_x",
+        ),
+        (
             "bad_cylinder",
             "let s = simulation(cloth_grid(0.5, 0.5, 5, 5, fabric()));\ns.add_cylinder([0.0, 0.0, 0.0], [0.0, 0.0, 0.0], 0.1, 1.0);\n",
             "axis",

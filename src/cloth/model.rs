@@ -278,6 +278,26 @@ impl ClothModel {
         }
     }
 
+    /// Moves the particles as a uniform in-plane strain would: x stretched by `1 + ex` and y by
+    /// `1 + ey` about the centre of the positions' bounding box (negative: compressed). The
+    /// rest shape is kept, so the cloth starts strained: a sheet held on its borders this way
+    /// is under uniform tension or compression from the first step.
+    pub fn prestrain(&mut self, ex: f64, ey: f64) {
+        let (mut lo, mut hi) = (
+            crate::geometry::Vec3::repeat(f64::INFINITY),
+            crate::geometry::Vec3::repeat(f64::NEG_INFINITY),
+        );
+        for p in &self.mesh.positions {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        let c = (lo + hi) * 0.5;
+        for p in &mut self.mesh.positions {
+            p.x = c.x + (p.x - c.x) * (1.0 + ex);
+            p.y = c.y + (p.y - c.y) * (1.0 + ey);
+        }
+    }
+
     /// Number of particles.
     pub fn particle_count(&self) -> usize {
         self.mass.len()

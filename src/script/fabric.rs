@@ -216,6 +216,32 @@ The same seed gives bit-identical positions; another seed may flip the wrinkles.
             Ok(ClothHandle(Shared::new(m)))
         }
     );
+    register!(
+        engine,
+        "prestrained",
+        [
+            "cloth: Cloth",
+            "strain_x: float",
+            "strain_y: float",
+            "Cloth"
+        ],
+        "A copy of the cloth whose particles are moved as by a uniform in-plane strain: x stretched
+by 1 + strain_x and y by 1 + strain_y about the cloth's centre (negative: compressed). The rest
+shape is kept, so a cloth held on its borders starts under uniform tension or compression.
+Strains must be finite and above −1.",
+        |c: &mut ClothHandle, ex: Dynamic, ey: Dynamic| -> RResult<ClothHandle> {
+            let ex = super::convert::finite(&ex, "strain_x")?;
+            let ey = super::convert::finite(&ey, "strain_y")?;
+            for (v, name) in [(ex, "strain_x"), (ey, "strain_y")] {
+                if v <= -1.0 {
+                    return Err(rt_err(format!("{name} = {v} must be above -1")));
+                }
+            }
+            let mut m = (*c.0).clone();
+            m.prestrain(ex, ey);
+            Ok(ClothHandle(Shared::new(m)))
+        }
+    );
     getter!(
         engine,
         "vertex_count",
