@@ -4,6 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::contact::Body;
 use crate::geometry::Vec3;
 
 /// A rigid translation over time, applied to attached particles' anchor positions.
@@ -188,8 +189,17 @@ impl Filter {
 /// (normal direction, S = I − n nᵀ, with the normal velocity it wants), after the step it may
 /// correct positions. Implemented by obstacles (the floor here, bodies in the contact issue).
 pub trait ContactHook: Send + Sync + std::fmt::Debug {
-    /// Adds contact constraints for the step from `t` to `t + dt`.
-    fn constrain(&mut self, x: &[Vec3], v: &[Vec3], t: f64, dt: f64, filter: &mut Filter);
+    /// Adds contact constraints for the step from `t` to `t + dt`; `obstacles` are the
+    /// simulation's collision bodies, for hooks that must not send particles into them.
+    fn constrain(
+        &mut self,
+        x: &[Vec3],
+        v: &[Vec3],
+        t: f64,
+        dt: f64,
+        filter: &mut Filter,
+        obstacles: Obstacles<'_>,
+    );
     /// Corrects positions and velocities after the step (default: nothing).
     fn correct(&mut self, _x: &mut [Vec3], _v: &mut [Vec3]) {}
 }
@@ -204,8 +214,42 @@ pub struct Floor {
     pub thickness: f64,
 }
 
+/// The simulation's collision bodies as a contact hook sees them.
+#[derive(Debug, Clone, Copy)]
+pub struct Obstacles<'a> {
+    /// The bodies.
+    pub bodies: &'a [Body],
+    /// Distance the cloth keeps from them (m).
+    pub clearance: f64,
+}
+
+impl Obstacles<'_> {
+    /// No bodies.
+    pub fn none() -> Obstacles<'static> {
+        Obstacles {
+            bodies: &[],
+            clearance: 0.0,
+        }
+    }
+
+    /// Whether `p` is at least the clearance away from every body (outside all of them).
+    pub fn is_clear(&self, p: &Vec3) -> bool {
+        self.bodies
+            .iter()
+            .all(|b| b.proximity(p, self.clearance).is_none())
+    }
+}
+
 impl ContactHook for Floor {
-    fn constrain(&mut self, x: &[Vec3], v: &[Vec3], _t: f64, dt: f64, filter: &mut Filter) {
+    fn constrain(
+        &mut self,
+        x: &[Vec3],
+        v: &[Vec3],
+        _t: f64,
+        dt: f64,
+        filter: &mut Filter,
+        _obstacles: Obstacles<'_>,
+    ) {
         let rest = self.height + self.thickness;
         for i in 0..x.len() {
             let gap = x[i].z - rest;

@@ -22,7 +22,7 @@ pub mod state;
 pub mod stats;
 pub mod wrinkles;
 
-pub use constraints::{Attachment, ContactHook, Filter, Floor, Trajectory};
+pub use constraints::{Attachment, ContactHook, Filter, Floor, Obstacles, Trajectory};
 pub use error::ClothError;
 pub use material::{Direction, FabricParameters, Friction, LinearMaterial, MaterialLaw};
 pub use measured::{MeasuredLaw, ResponseCurve};

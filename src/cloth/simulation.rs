@@ -7,7 +7,7 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use super::assembly::{Assembly, AssemblyInputs};
-use super::constraints::{Attachment, ContactHook, Filter, ParticleFilter, Trajectory};
+use super::constraints::{Attachment, ContactHook, Filter, Obstacles, ParticleFilter, Trajectory};
 use super::model::ClothModel;
 use super::multigrid::Multigrid;
 use super::pcg::{PcgResult, PcgWorkspace, Preconditioner};
@@ -305,6 +305,10 @@ impl Simulation {
                 &mut self.filter,
             );
         }
+        let obstacles = Obstacles {
+            bodies: &self.contact.bodies,
+            clearance: self.contact.settings.thickness,
+        };
         for hook in &mut self.hooks {
             hook.constrain(
                 &self.state.x,
@@ -312,6 +316,7 @@ impl Simulation {
                 self.state.time,
                 dt,
                 &mut self.filter,
+                obstacles,
             );
         }
         for at in &self.attachments {
