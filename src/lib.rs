@@ -12,6 +12,7 @@ pub mod bench;
 pub mod body;
 pub mod cloth;
 pub mod contact;
+pub mod facade;
 pub mod garment;
 pub mod geometry;
 pub mod kes;

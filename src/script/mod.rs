@@ -16,6 +16,7 @@ pub mod contact;
 pub mod convert;
 pub mod docs;
 pub mod fabric;
+pub mod facade;
 pub mod garment;
 pub mod kes;
 pub mod measure;
@@ -109,6 +110,7 @@ pub fn build_engine_with(limits: EngineLimits) -> Engine {
     garment::register(&mut engine);
     output::register(&mut engine);
     measure::register(&mut engine);
+    facade::register(&mut engine);
     kes::register(&mut engine);
     engine
 }

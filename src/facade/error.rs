@@ -1,0 +1,34 @@
+//! Errors of the facade module.
+
+use std::path::PathBuf;
+
+/// What can go wrong reading or scoring facades.
+#[derive(Debug, thiserror::Error)]
+pub enum FacadeError {
+    /// A file could not be read or decoded.
+    #[error("{path}: {message}")]
+    File {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// A label map holds a colour its colour map does not know.
+    #[error("{path}: pixel ({x}, {y}) has colour {rgb:?}, which is not in the colour map")]
+    UnknownColour {
+        /// The file.
+        path: PathBuf,
+        /// Column.
+        x: u32,
+        /// Row.
+        y: u32,
+        /// The colour.
+        rgb: [u8; 3],
+    },
+    /// Two maps that must match in size do not.
+    #[error("size mismatch: {what}")]
+    Size {
+        /// Which maps.
+        what: String,
+    },
+}
