@@ -1,16 +1,22 @@
 //! Facades: reconstruction of building facades from photos (Müller, Zeng, Wonka & Van Gool
-//! 2007), and its evaluation against labelled photos. So far this module holds the evaluation:
-//! label maps in canonical classes ([`labels`]), window instances of a label map
-//! ([`instances`]), and the pixel and window-detection scores of a prediction ([`score`]), as
-//! the protocol of `facade-reconstruction.md` §4 defines them.
+//! 2007), and its evaluation against labelled photos. So far: the evaluation — label maps in
+//! canonical classes ([`labels`]), window instances of a label map ([`instances`]), the pixel
+//! and window-detection scores of a prediction ([`score`], protocol of
+//! `facade-reconstruction.md` §4) and folder reports ([`report`]); and the first analysis
+//! stage — grayscale photos ([`gray`]), mutual information of image bands
+//! ([`mutual_information`]) and the floor and tile repetition it reveals ([`repetition`]).
 
 pub mod assignment;
 pub mod error;
+pub mod gray;
 pub mod instances;
 pub mod labels;
+pub mod mutual_information;
 pub mod rect;
+pub mod repetition;
 pub mod report;
 pub mod score;
+pub mod structure;
 
 pub use error::FacadeError;
 pub use labels::{Class, LabelMap};

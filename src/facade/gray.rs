@@ -1,0 +1,48 @@
+//! Grayscale images for the structure analysis: 8-bit Rec. 601 luma, row-major, as the
+//! mutual-information search reads them.
+
+use std::path::Path;
+
+use super::error::FacadeError;
+
+/// An 8-bit grayscale image.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Gray {
+    /// Columns.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+    /// Luma of pixel (x, y) at `y · width + x`.
+    pub data: Vec<u8>,
+}
+
+impl Gray {
+    /// Reads a photo (JPEG or PNG) and converts it to luma (0.299 R + 0.587 G + 0.114 B).
+    pub fn read(path: &Path) -> Result<Self, FacadeError> {
+        let img = image::open(path)
+            .map_err(|e| FacadeError::File {
+                path: path.to_path_buf(),
+                message: e.to_string(),
+            })?
+            .to_rgb8();
+        let (width, height) = img.dimensions();
+        let data = img
+            .pixels()
+            .map(|p| {
+                let [r, g, b] = p.0;
+                (0.299 * r as f64 + 0.587 * g as f64 + 0.114 * b as f64).round() as u8
+            })
+            .collect();
+        Ok(Gray {
+            width,
+            height,
+            data,
+        })
+    }
+
+    /// Luma at (x, y).
+    #[inline]
+    pub fn at(&self, x: u32, y: u32) -> u8 {
+        self.data[y as usize * self.width as usize + x as usize]
+    }
+}
