@@ -9,6 +9,7 @@
 pub mod assignment;
 pub mod error;
 pub mod gray;
+pub mod homography;
 pub mod instances;
 pub mod labels;
 pub mod mutual_information;

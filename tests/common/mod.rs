@@ -1,0 +1,54 @@
+//! Helpers shared by the facade tests: a synthetic facade with known floor height and tile
+//! width (windows in frames on a textured wall, a lighting gradient from floor to floor, a
+//! tree in front of the lower left).
+#![allow(dead_code)]
+
+use emilion::facade::gray::Gray;
+
+pub const FLOOR: u32 = 57;
+pub const TILE: u32 = 43;
+/// Window rectangle inside each tile: columns 10..34, rows 12..45.
+pub const WIN_X: (u32, u32) = (10, 34);
+pub const WIN_Y: (u32, u32) = (12, 45);
+
+pub fn facade(width: u32, height: u32, seed: u64) -> Gray {
+    let mut s = seed;
+    let mut rnd = || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (s >> 40) as f64 / (1u64 << 24) as f64
+    };
+    let mut data = Vec::with_capacity((width * height) as usize);
+    for y in 0..height {
+        for x in 0..width {
+            let (tx, ty) = (x % TILE, y % FLOOR);
+            let window = (WIN_X.0..WIN_X.1).contains(&tx) && (WIN_Y.0..WIN_Y.1).contains(&ty);
+            let frame = !window
+                && (WIN_X.0 - 2..WIN_X.1 + 2).contains(&tx)
+                && (WIN_Y.0 - 2..WIN_Y.1 + 2).contains(&ty);
+            // lighter floors further up, as sun on a facade
+            let light = 1.0 - 0.25 * y as f64 / height as f64;
+            let base = if window {
+                55.0
+            } else if frame {
+                225.0
+            } else {
+                165.0
+            };
+            let mut v = base * light + 24.0 * (rnd() - 0.5);
+            // a tree in front of the lower left
+            let (dx, dy) = (x as f64 - 60.0, y as f64 - height as f64 + 40.0);
+            if dx * dx / 900.0 + dy * dy / 2500.0 < 1.0 {
+                v = 70.0 + 40.0 * rnd();
+            }
+            data.push(v.clamp(0.0, 255.0) as u8);
+        }
+    }
+    Gray {
+        width,
+        height,
+        data,
+    }
+}
+
