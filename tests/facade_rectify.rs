@@ -18,17 +18,26 @@ fn view() -> Homography {
     ))
 }
 
+/// The rectifying homography from the `w` × `h` facade's corners as a user would click them
+/// in the view.
+fn rectifier(v: &Homography, w: u32, h: u32) -> Homography {
+    let corners = [
+        [0.0, 0.0],
+        [w as f64, 0.0],
+        [w as f64, h as f64],
+        [0.0, h as f64],
+    ]
+    .map(|p| v.apply(p).unwrap());
+    Homography::rectifying(&corners, w as f64, h as f64).unwrap()
+}
+
 #[test]
 fn four_corners_restore_the_fronto_parallel_facade() {
     let (w, h) = (301, 259);
     let front = facade(w, h, 11);
     let v = view();
     let photo = warp_gray(&front, &v, 560, 460).unwrap();
-    // the facade's corners as a user would click them in the photo
-    let corners = [[0.0, 0.0], [w as f64, 0.0], [w as f64, h as f64], [0.0, h as f64]]
-        .map(|p| v.apply(p).unwrap());
-    let rect = Homography::rectifying(&corners, w as f64, h as f64).unwrap();
-    let back = warp_gray(&photo, &rect, w, h).unwrap();
+    let back = warp_gray(&photo, &rectifier(&v, w, h), w, h).unwrap();
     // the same picture up to resampling blur (two bilinear passes on a noisy texture)
     let mad = back
         .data
@@ -64,10 +73,7 @@ fn label_maps_follow_the_same_warp() {
     let photo = warp_labels(&labels, &v, 560, 460).unwrap();
     // outside the facade the warped map is ignore
     assert_eq!(photo.at(559, 0), Class::Ignore);
-    let corners = [[0.0, 0.0], [w as f64, 0.0], [w as f64, h as f64], [0.0, h as f64]]
-        .map(|p| v.apply(p).unwrap());
-    let rect = Homography::rectifying(&corners, w as f64, h as f64).unwrap();
-    let back = warp_labels(&photo, &rect, w, h).unwrap();
+    let back = warp_labels(&photo, &rectifier(&v, w, h), w, h).unwrap();
     let same = back
         .classes
         .iter()

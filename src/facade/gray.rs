@@ -19,12 +19,7 @@ pub struct Gray {
 impl Gray {
     /// Reads a photo (JPEG or PNG) and converts it to luma (0.299 R + 0.587 G + 0.114 B).
     pub fn read(path: &Path) -> Result<Self, FacadeError> {
-        let img = image::open(path)
-            .map_err(|e| FacadeError::File {
-                path: path.to_path_buf(),
-                message: e.to_string(),
-            })?
-            .to_rgb8();
+        let img = read_rgb(path)?;
         let (width, height) = img.dimensions();
         let data = img
             .pixels()
@@ -45,4 +40,14 @@ impl Gray {
     pub fn at(&self, x: u32, y: u32) -> u8 {
         self.data[y as usize * self.width as usize + x as usize]
     }
+}
+
+/// Reads an image file (JPEG or PNG) as 8-bit RGB, errors naming the file.
+pub(crate) fn read_rgb(path: &Path) -> Result<image::RgbImage, FacadeError> {
+    Ok(image::open(path)
+        .map_err(|e| FacadeError::File {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?
+        .to_rgb8())
 }

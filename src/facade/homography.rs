@@ -27,6 +27,9 @@ impl Homography {
     /// The homography taking each `from[k]` to `to[k]` (four points, no three collinear), or
     /// `None` for a degenerate configuration.
     pub fn from_points(from: &[[f64; 2]; 4], to: &[[f64; 2]; 4]) -> Option<Homography> {
+        if has_collinear_triple(from) || has_collinear_triple(to) {
+            return None;
+        }
         let (tf, nf) = normalisation(from);
         let (tt, nt) = normalisation(to);
         let mut a = DMatrix::<f64>::zeros(9, 9);
@@ -45,11 +48,14 @@ impl Homography {
         // vector of the square matrix
         let svd = a.svd(false, true);
         let vt = svd.v_t?;
-        let (k, smin) = svd
-            .singular_values
-            .iter()
-            .enumerate()
-            .fold((0, f64::INFINITY), |b, (i, &s)| if s < b.1 { (i, s) } else { b });
+        let (k, smin) =
+            svd.singular_values
+                .iter()
+                .enumerate()
+                .fold(
+                    (0, f64::INFINITY),
+                    |b, (i, &s)| if s < b.1 { (i, s) } else { b },
+                );
         let second = svd
             .singular_values
             .iter()
@@ -80,6 +86,24 @@ impl Homography {
             &[[0.0, 0.0], [width, 0.0], [width, height], [0.0, height]],
         )
     }
+}
+
+/// Whether three of the four points are (nearly) collinear: a triangle of them has an area
+/// under 1e-9 of the squared spread of the points.
+fn has_collinear_triple(p: &[[f64; 2]; 4]) -> bool {
+    let spread = p
+        .iter()
+        .flat_map(|a| {
+            p.iter()
+                .map(move |b| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2))
+        })
+        .fold(0.0, f64::max);
+    let area = |a: [f64; 2], b: [f64; 2], c: [f64; 2]| {
+        ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])).abs() * 0.5
+    };
+    [(0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)]
+        .iter()
+        .any(|&(i, j, k)| area(p[i], p[j], p[k]) <= 1e-9 * spread)
 }
 
 /// Hartley's normalisation: translate the points' centroid to the origin and scale their

@@ -120,32 +120,21 @@ pub fn write_summary(
     );
     for r in reports {
         let (p, w) = (&r.score.pixels, &r.score.windows);
-        csv += &format!(
-            "{},{:.4},{:.4},{:.4},{},{},{},{:.4},{:.4},{:.4}\n",
-            r.name,
-            p.iou(Class::Window),
-            p.accuracy(),
-            p.iou(Class::Door),
-            w.true_positives,
-            w.false_positives,
-            w.false_negatives,
-            w.precision(),
-            w.recall(),
-            w.f1()
-        );
-        md += &format!(
-            "| {} | {:.3} | {:.3} | {:.3} | {} | {} | {} | {:.2} | {:.2} | {:.3} |\n",
-            r.name,
-            p.iou(Class::Window),
-            p.accuracy(),
-            p.iou(Class::Door),
-            w.true_positives,
-            w.false_positives,
-            w.false_negatives,
-            w.precision(),
-            w.recall(),
-            w.f1()
-        );
+        let rates = [p.iou(Class::Window), p.accuracy(), p.iou(Class::Door)];
+        let counts = [w.true_positives, w.false_positives, w.false_negatives];
+        let prf = [w.precision(), w.recall(), w.f1()];
+        let join = |v: Vec<String>, sep: &str| v.join(sep);
+        let cells = |digits: [usize; 3]| -> Vec<String> {
+            std::iter::once(r.name.clone())
+                .chain(rates.iter().map(|v| format!("{v:.*}", digits[0])))
+                .chain(counts.iter().map(|c| c.to_string()))
+                .chain(prf[..2].iter().map(|v| format!("{v:.*}", digits[1])))
+                .chain(std::iter::once(format!("{:.*}", digits[2], prf[2])))
+                .collect()
+        };
+        csv += &join(cells([4, 4, 4]), ",");
+        csv.push('\n');
+        md += &format!("| {} |\n", join(cells([3, 2, 3]), " | "));
     }
     md += &format!(
         "\n**{} images**: mean window IoU {:.3}, mean F1@0.5 {:.3}; pooled pixel accuracy {:.3}, \

@@ -51,4 +51,3 @@ pub fn facade(width: u32, height: u32, seed: u64) -> Gray {
         data,
     }
 }
-
