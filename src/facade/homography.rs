@@ -63,7 +63,8 @@ impl Homography {
             .filter(|(i, _)| *i != k)
             .map(|(_, &s)| s)
             .fold(f64::INFINITY, f64::min);
-        if !(second > 1e-9 * svd.singular_values.max()) || !smin.is_finite() {
+        let rank_deficient = second.is_nan() || second <= 1e-9 * svd.singular_values.max();
+        if rank_deficient || !smin.is_finite() {
             return None;
         }
         let h = vt.row(k);
