@@ -8,11 +8,13 @@
 
 pub mod assignment;
 pub mod error;
+pub mod grammar;
 pub mod gray;
 pub mod homography;
 pub mod instances;
 pub mod labels;
 pub mod mutual_information;
+pub mod parse;
 pub mod rect;
 pub mod repetition;
 pub mod report;

@@ -1,0 +1,526 @@
+//! The facade shape grammar (Müller et al. 2006–2007, CGA-like): a tree of splits and repeats
+//! whose leaves are facade classes, its derivation into labelled rectangles at any size, and
+//! its rule file. A [`Rule`] set is what a parse produces; deriving it at the photo's size
+//! reproduces the parse, and at other sizes generates new facades of the same style.
+//!
+//! Sizes follow CGA: a part is either **fixed** (`12.5`: its size in facade units whatever
+//! the scope) or **floating** (`~30`: a relative weight sharing what the fixed parts leave).
+//! `repeat` fills its scope with as many tiles of its nominal size as fit (at least one),
+//! stretched to fill it exactly. The rule file reads back into the same rules
+//! ([`Grammar::parse`]), so the file alone regenerates the facade.
+
+use std::collections::BTreeMap;
+use std::fmt::Write;
+
+use super::labels::Class;
+
+/// A rectangle in facade units (pixels of the rectified photo at the parse's own size),
+/// y down: `[x0, x1) × [y0, y1)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scope {
+    /// Left.
+    pub x0: f64,
+    /// Top.
+    pub y0: f64,
+    /// Right.
+    pub x1: f64,
+    /// Bottom.
+    pub y1: f64,
+}
+
+impl Scope {
+    /// Width.
+    pub fn width(&self) -> f64 {
+        self.x1 - self.x0
+    }
+    /// Height.
+    pub fn height(&self) -> f64 {
+        self.y1 - self.y0
+    }
+    fn along(&self, axis: Dir) -> (f64, f64) {
+        match axis {
+            Dir::X => (self.x0, self.x1),
+            Dir::Y => (self.y0, self.y1),
+        }
+    }
+    fn with(&self, axis: Dir, a: f64, b: f64) -> Scope {
+        match axis {
+            Dir::X => Scope {
+                x0: a,
+                x1: b,
+                ..*self
+            },
+            Dir::Y => Scope {
+                y0: a,
+                y1: b,
+                ..*self
+            },
+        }
+    }
+}
+
+/// Split direction: `X` cuts the scope into columns (left to right), `Y` into rows (top to
+/// bottom).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dir {
+    /// Columns.
+    X,
+    /// Rows.
+    Y,
+}
+
+impl Dir {
+    fn name(self) -> &'static str {
+        match self {
+            Dir::X => "x",
+            Dir::Y => "y",
+        }
+    }
+}
+
+/// The size of a split part.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Size {
+    /// Fixed, in facade units.
+    Fixed(f64),
+    /// Floating: a relative weight of what the fixed parts leave.
+    Floating(f64),
+}
+
+/// The right-hand side of a rule.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Body {
+    /// Cut the scope along a direction into parts, each given to a rule.
+    Split {
+        /// Direction.
+        dir: Dir,
+        /// (size, rule name) of each part, in order.
+        parts: Vec<(Size, String)>,
+    },
+    /// Fill the scope along a direction with copies of one rule, each about `size` long.
+    Repeat {
+        /// Direction.
+        dir: Dir,
+        /// Nominal tile size (facade units).
+        size: f64,
+        /// The tile's rule.
+        rule: String,
+    },
+    /// A terminal shape of a class (an element of the library is inserted there).
+    Leaf(Class),
+}
+
+/// A derived terminal shape: where it is, what it is, and where it came from in the parsed
+/// photo (the same place at the parse's own size; in a resized facade, the corresponding
+/// place of the tile it repeats), so generated facades can be textured with the photo.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Leaf {
+    /// Where it is.
+    pub scope: Scope,
+    /// Its class.
+    pub class: Class,
+    /// The corresponding rectangle of the parsed photo.
+    pub source: Scope,
+}
+
+/// A facade grammar: named rules and the axiom's size.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Grammar {
+    /// Rules by name.
+    pub rules: BTreeMap<String, Body>,
+    /// The start rule.
+    pub axiom: String,
+    /// Width and height of the parsed facade (facade units).
+    pub size: (f64, f64),
+}
+
+/// Deepest derivation: a rule that reaches itself is an error, not a stack overflow.
+const MAX_DEPTH: usize = 64;
+
+impl Grammar {
+    /// Derives the facade at `width` × `height`: the terminal shapes, in derivation order.
+    /// Errors name the rule: an unknown rule, a cycle, a non-positive size, or fixed parts
+    /// that do not fit their scope.
+    pub fn derive(&self, width: f64, height: f64) -> Result<Vec<Leaf>, String> {
+        if !(width > 0.0 && height > 0.0 && width.is_finite() && height.is_finite()) {
+            return Err(format!("facade size {width} × {height} must be positive"));
+        }
+        let mut out = Vec::new();
+        let scope = Scope {
+            x0: 0.0,
+            y0: 0.0,
+            x1: width,
+            y1: height,
+        };
+        let source = Scope {
+            x0: 0.0,
+            y0: 0.0,
+            x1: self.size.0,
+            y1: self.size.1,
+        };
+        self.expand(&self.axiom, scope, source, 0, &mut out)?;
+        Ok(out)
+    }
+
+    fn expand(
+        &self,
+        name: &str,
+        scope: Scope,
+        source: Scope,
+        depth: usize,
+        out: &mut Vec<Leaf>,
+    ) -> Result<(), String> {
+        if depth > MAX_DEPTH {
+            return Err(format!(
+                "rule {name}: derivation deeper than {MAX_DEPTH} (a cycle?)"
+            ));
+        }
+        let body = self
+            .rules
+            .get(name)
+            .ok_or_else(|| format!("unknown rule {name}"))?;
+        match body {
+            Body::Leaf(class) => out.push(Leaf {
+                scope,
+                class: *class,
+                source,
+            }),
+            Body::Split { dir, parts } => {
+                let sizes: Vec<Size> = parts.iter().map(|p| p.0).collect();
+                let (a, b) = scope.along(*dir);
+                let (sa, sb) = source.along(*dir);
+                let cuts =
+                    split_positions(&sizes, a, b).map_err(|e| format!("rule {name}: {e}"))?;
+                let scuts =
+                    split_positions(&sizes, sa, sb).map_err(|e| format!("rule {name}: {e}"))?;
+                for (k, (_, rule)) in parts.iter().enumerate() {
+                    self.expand(
+                        rule,
+                        scope.with(*dir, cuts[k], cuts[k + 1]),
+                        source.with(*dir, scuts[k], scuts[k + 1]),
+                        depth + 1,
+                        out,
+                    )?;
+                }
+            }
+            Body::Repeat { dir, size, rule } => {
+                if !(*size > 0.0 && size.is_finite()) {
+                    return Err(format!("rule {name}: repeat size {size} must be positive"));
+                }
+                let (a, b) = scope.along(*dir);
+                let (sa, sb) = source.along(*dir);
+                let n = repeat_count(b - a, *size);
+                let ns = repeat_count(sb - sa, *size);
+                for k in 0..n {
+                    // the k-th tile shows the photo's tile at the same place from the start,
+                    // wrapping round the photo's tiles
+                    let ks = k % ns;
+                    let step = (b - a) / n as f64;
+                    let sstep = (sb - sa) / ns as f64;
+                    self.expand(
+                        rule,
+                        scope.with(*dir, a + k as f64 * step, a + (k + 1) as f64 * step),
+                        source.with(*dir, sa + ks as f64 * sstep, sa + (ks + 1) as f64 * sstep),
+                        depth + 1,
+                        out,
+                    )?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The rule file: one rule per line, `Name --> split(y) { 12: A | ~30: B }`,
+    /// `Name --> repeat(x, 43.5) { Tile }`, `Name --> window`; the axiom first, with the
+    /// parsed size in a header comment.
+    pub fn to_text(&self) -> String {
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "// facade grammar (CGA-like): fixed sizes in facade units, ~w a floating weight\n// axiom {} size {} {}",
+            self.axiom,
+            fmt_num(self.size.0),
+            fmt_num(self.size.1)
+        );
+        let mut names: Vec<&String> = self.rules.keys().collect();
+        names.sort_by_key(|n| (*n != &self.axiom, n.as_str()));
+        for name in names {
+            let _ = write!(s, "{name} --> ");
+            match &self.rules[name] {
+                Body::Leaf(c) => {
+                    let _ = writeln!(s, "{}", c.name());
+                }
+                Body::Repeat { dir, size, rule } => {
+                    let _ = writeln!(s, "repeat({}, {}) {{ {rule} }}", dir.name(), fmt_num(*size));
+                }
+                Body::Split { dir, parts } => {
+                    let p: Vec<String> = parts
+                        .iter()
+                        .map(|(sz, r)| match sz {
+                            Size::Fixed(v) => format!("{}: {r}", fmt_num(*v)),
+                            Size::Floating(v) => format!("~{}: {r}", fmt_num(*v)),
+                        })
+                        .collect();
+                    let _ = writeln!(s, "split({}) {{ {} }}", dir.name(), p.join(" | "));
+                }
+            }
+        }
+        s
+    }
+
+    /// Reads a rule file written by [`Grammar::to_text`] (or by hand in the same syntax).
+    /// Errors give the line number and what was expected.
+    pub fn parse(text: &str) -> Result<Grammar, String> {
+        let mut rules = BTreeMap::new();
+        let (mut axiom, mut size) = (None, None);
+        for (ln, raw) in text.lines().enumerate() {
+            let line = raw.trim();
+            let err = |m: &str| format!("line {}: {m}: `{line}`", ln + 1);
+            if let Some(c) = line.strip_prefix("//") {
+                let w: Vec<&str> = c.split_whitespace().collect();
+                if w.len() == 5 && w[0] == "axiom" && w[2] == "size" {
+                    axiom = Some(w[1].to_string());
+                    let (a, b) = (w[3].parse::<f64>(), w[4].parse::<f64>());
+                    match (a, b) {
+                        (Ok(a), Ok(b)) => size = Some((a, b)),
+                        _ => return Err(err("the axiom's size is not two numbers")),
+                    }
+                }
+                continue;
+            }
+            if line.is_empty() {
+                continue;
+            }
+            let (name, rhs) = line
+                .split_once("-->")
+                .ok_or_else(|| err("expected `Name --> body`"))?;
+            let name = name.trim();
+            if name.is_empty() || !name.chars().all(|c| c.is_alphanumeric() || c == '_') {
+                return Err(err("a rule name is letters, digits and _"));
+            }
+            let rhs = rhs.trim();
+            let body = if let Some(class) = Class::from_name(rhs) {
+                Body::Leaf(class)
+            } else {
+                let (head, inner) = rhs
+                    .split_once('{')
+                    .and_then(|(h, r)| r.trim_end().strip_suffix('}').map(|i| (h.trim(), i)))
+                    .ok_or_else(|| {
+                        err("expected a class name, split(..) { .. } or repeat(..) { .. }")
+                    })?;
+                let args = head
+                    .split_once('(')
+                    .and_then(|(op, a)| a.strip_suffix(')').map(|a| (op.trim(), a)))
+                    .ok_or_else(|| err("expected split(dir) or repeat(dir, size)"))?;
+                let dir_of = |s: &str| match s.trim() {
+                    "x" => Ok(Dir::X),
+                    "y" => Ok(Dir::Y),
+                    _ => Err(err("direction must be x or y")),
+                };
+                match args.0 {
+                    "split" => {
+                        let dir = dir_of(args.1)?;
+                        let mut parts = Vec::new();
+                        for p in inner.split('|') {
+                            let (sz, r) = p
+                                .split_once(':')
+                                .ok_or_else(|| err("a split part is `size: Rule`"))?;
+                            let sz = sz.trim();
+                            let size = match sz.strip_prefix('~') {
+                                Some(w) => Size::Floating(
+                                    w.parse().map_err(|_| err("bad floating weight"))?,
+                                ),
+                                None => Size::Fixed(sz.parse().map_err(|_| err("bad size"))?),
+                            };
+                            parts.push((size, r.trim().to_string()));
+                        }
+                        Body::Split { dir, parts }
+                    }
+                    "repeat" => {
+                        let (d, s) = args
+                            .1
+                            .split_once(',')
+                            .ok_or_else(|| err("repeat takes (dir, size)"))?;
+                        Body::Repeat {
+                            dir: dir_of(d)?,
+                            size: s.trim().parse().map_err(|_| err("bad repeat size"))?,
+                            rule: inner.trim().to_string(),
+                        }
+                    }
+                    _ => return Err(err("unknown operation (split, repeat)")),
+                }
+            };
+            if rules.insert(name.to_string(), body).is_some() {
+                return Err(err("rule defined twice"));
+            }
+        }
+        let axiom = axiom.ok_or("missing `// axiom Name size W H` header")?;
+        let size = size.ok_or("missing the axiom's size")?;
+        let g = Grammar { rules, axiom, size };
+        g.check()?;
+        Ok(g)
+    }
+
+    /// Every referenced rule exists and every size is finite and non-negative.
+    pub fn check(&self) -> Result<(), String> {
+        if !self.rules.contains_key(&self.axiom) {
+            return Err(format!("the axiom {} has no rule", self.axiom));
+        }
+        for (name, body) in &self.rules {
+            let refs: Vec<&String> = match body {
+                Body::Leaf(_) => Vec::new(),
+                Body::Repeat { rule, size, .. } => {
+                    if !(*size > 0.0 && size.is_finite()) {
+                        return Err(format!("rule {name}: repeat size {size} must be positive"));
+                    }
+                    vec![rule]
+                }
+                Body::Split { parts, .. } => {
+                    for (s, _) in parts {
+                        let v = match s {
+                            Size::Fixed(v) | Size::Floating(v) => *v,
+                        };
+                        if !(v >= 0.0 && v.is_finite()) {
+                            return Err(format!("rule {name}: size {v} must be ≥ 0"));
+                        }
+                    }
+                    parts.iter().map(|p| &p.1).collect()
+                }
+            };
+            if let Some(r) = refs.iter().find(|r| !self.rules.contains_key(r.as_str())) {
+                return Err(format!("rule {name} refers to unknown rule {r}"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Tiles of nominal `size` that fill `extent`: the nearest whole number, at least one.
+pub fn repeat_count(extent: f64, size: f64) -> usize {
+    ((extent / size).round() as usize).max(1)
+}
+
+/// Cut positions of a split of `[a, b]` into parts of `sizes`: fixed parts keep their size,
+/// floating ones share the rest by weight. When the fixed parts alone overflow the scope (a
+/// facade derived smaller than its parse), they shrink in proportion and floating parts get
+/// nothing: a derivation never makes negative or overlapping shapes.
+pub fn split_positions(sizes: &[Size], a: f64, b: f64) -> Result<Vec<f64>, String> {
+    if sizes.is_empty() {
+        return Err("a split needs at least one part".into());
+    }
+    let extent = b - a;
+    let fixed: f64 = sizes
+        .iter()
+        .map(|s| if let Size::Fixed(v) = s { *v } else { 0.0 })
+        .sum();
+    let weights: f64 = sizes
+        .iter()
+        .map(|s| if let Size::Floating(v) = s { *v } else { 0.0 })
+        .sum();
+    let (fixed_scale, float_unit) = if fixed > extent || weights <= 0.0 {
+        // shrink (or stretch, with nothing floating) the fixed parts to fit exactly
+        (if fixed > 0.0 { extent / fixed } else { 0.0 }, 0.0)
+    } else {
+        (1.0, (extent - fixed) / weights)
+    };
+    if fixed <= 0.0 && weights <= 0.0 {
+        return Err("every part has size 0".into());
+    }
+    let mut cuts = Vec::with_capacity(sizes.len() + 1);
+    let mut at = a;
+    cuts.push(at);
+    for s in sizes {
+        at += match s {
+            Size::Fixed(v) => v * fixed_scale,
+            Size::Floating(w) => w * float_unit,
+        };
+        cuts.push(at);
+    }
+    // the last cut is exactly the scope's end, whatever the rounding
+    *cuts.last_mut().expect("cuts") = b;
+    Ok(cuts)
+}
+
+/// Shortest decimal that reads back to the same f64 (Rust's `Display`), but integers without
+/// a fraction.
+fn fmt_num(v: f64) -> String {
+    format!("{v}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Grammar {
+        Grammar::parse(
+            "// axiom Facade size 430 300\n\
+             Facade --> split(y) { 30: Top | ~1: Floors | 42.5: Ground }\n\
+             Floors --> repeat(y, 57) { Floor }\n\
+             Floor --> split(x) { 43: Wall | ~344: Tiles | 43: Wall }\n\
+             Tiles --> repeat(x, 43) { Tile }\n\
+             Tile --> split(x) { ~10: Wall | 24: Col | ~9: Wall }\n\
+             Col --> split(y) { ~12: Wall | 33: Window | ~12: Wall }\n\
+             Top --> background\nGround --> door\nWall --> wall\nWindow --> window\n",
+        )
+        .expect("parses")
+    }
+
+    #[test]
+    fn text_round_trips_and_derivation_fills_the_scope() {
+        let g = sample();
+        let back = Grammar::parse(&g.to_text()).expect("reads its own text");
+        assert_eq!(back, g);
+        let leaves = g.derive(430.0, 300.0).expect("derives");
+        let area: f64 = leaves
+            .iter()
+            .map(|l| l.scope.width() * l.scope.height())
+            .sum();
+        assert!(
+            (area - 430.0 * 300.0).abs() < 1e-6,
+            "leaves tile the facade: {area}"
+        );
+        // 300 − 72.5 = 227.5 → 4 floors; 8 tiles; one window each
+        let windows = leaves.iter().filter(|l| l.class == Class::Window).count();
+        assert_eq!(windows, 4 * 8);
+        for l in &leaves {
+            assert_eq!(
+                l.scope, l.source,
+                "at its own size the source is the place itself"
+            );
+        }
+        // at 1.5×: floors follow round((450 − 72.5)/57) = 7, tiles round((645 − 86)/43) = 13
+        let wide = g.derive(645.0, 450.0).expect("derives");
+        let w2 = wide.iter().filter(|l| l.class == Class::Window).count();
+        assert_eq!(w2, 7 * 13);
+        // window sizes stay absolute
+        for l in wide.iter().filter(|l| l.class == Class::Window) {
+            assert!(
+                (l.scope.width() - 24.0).abs() < 1e-9 && (l.scope.height() - 33.0).abs() < 1e-9
+            );
+        }
+    }
+
+    #[test]
+    fn bad_rules_are_rejected_with_the_line() {
+        let e = Grammar::parse("// axiom F size 10 10\nF --> split(z) { 1: A }\n").unwrap_err();
+        assert!(e.contains("line 2") && e.contains("direction"), "{e}");
+        let e = Grammar::parse("// axiom F size 10 10\nF --> split(x) { 1: A }\n").unwrap_err();
+        assert!(e.contains("unknown rule A"), "{e}");
+        let e = Grammar::parse("// axiom F size 10 10\nF --> repeat(x, 5) { F }\n")
+            .expect("parses")
+            .derive(10.0, 10.0)
+            .unwrap_err();
+        assert!(e.contains("cycle"), "{e}");
+    }
+
+    #[test]
+    fn fixed_parts_shrink_instead_of_overflowing() {
+        let c = split_positions(
+            &[Size::Fixed(6.0), Size::Floating(1.0), Size::Fixed(6.0)],
+            0.0,
+            10.0,
+        )
+        .expect("fits");
+        assert_eq!(c, vec![0.0, 5.0, 5.0, 10.0]);
+    }
+}
