@@ -5,29 +5,10 @@
 
 mod common;
 
-use common::{facade, FLOOR, TILE, WIN_X, WIN_Y};
+use common::{facade, window_truth, FLOOR, TILE};
 use emilion::facade::grammar::Grammar;
 use emilion::facade::parse::{parse, rasterize, Priors};
-use emilion::facade::{Class, LabelMap, PixelScore, Rect};
-
-/// The synthetic facade's own label map: its windows (frames count as wall).
-fn truth(width: u32, height: u32) -> LabelMap {
-    let mut m = LabelMap::filled(width, height, Class::Wall);
-    for fy in 0..height.div_ceil(FLOOR) {
-        for tx in 0..width.div_ceil(TILE) {
-            m.paint(
-                &Rect {
-                    x0: tx * TILE + WIN_X.0,
-                    y0: fy * FLOOR + WIN_Y.0,
-                    x1: (tx * TILE + WIN_X.1).min(width),
-                    y1: (fy * FLOOR + WIN_Y.1).min(height),
-                },
-                Class::Window,
-            );
-        }
-    }
-    m
-}
+use emilion::facade::{Class, PixelScore};
 
 #[test]
 fn synthetic_facade_parses_into_its_windows() {
@@ -45,7 +26,7 @@ fn synthetic_facade_parses_into_its_windows() {
     assert_eq!((s.floor, s.tile), (FLOOR, TILE));
     let leaves = g.derive(w as f64, h as f64).expect("derives");
     let p = rasterize(&leaves, w, h);
-    let score = PixelScore::of(&p.labels, &truth(w, h)).expect("same size");
+    let score = PixelScore::of(&p.labels, &window_truth(w, h)).expect("same size");
     let iou = score.iou(Class::Window);
     eprintln!("window IoU {iou:.3}, {} windows", p.windows.len());
     // the repeated part spans whole tiles only: windows cut by the image border are missed

@@ -31,4 +31,11 @@ pub enum FacadeError {
         /// Which maps.
         what: String,
     },
+    /// A photo could not be rectified automatically (too few line segments, no consistent
+    /// vanishing point, or a horizon through the image).
+    #[error("automatic rectification failed: {message}")]
+    Rectification {
+        /// Why.
+        message: String,
+    },
 }

@@ -17,10 +17,13 @@ pub struct Gray {
 }
 
 impl Gray {
-    /// Reads a photo (JPEG or PNG) and converts it to luma (0.299 R + 0.587 G + 0.114 B).
+    /// Reads a photo (JPEG or PNG) and converts it to luma.
     pub fn read(path: &Path) -> Result<Self, FacadeError> {
-        let img = read_rgb(path)?;
-        let (width, height) = img.dimensions();
+        Ok(Gray::from_rgb(&read_rgb(path)?))
+    }
+
+    /// The luma of a colour image (0.299 R + 0.587 G + 0.114 B, rounded).
+    pub fn from_rgb(img: &image::RgbImage) -> Self {
         let data = img
             .pixels()
             .map(|p| {
@@ -28,11 +31,11 @@ impl Gray {
                 (0.299 * r as f64 + 0.587 * g as f64 + 0.114 * b as f64).round() as u8
             })
             .collect();
-        Ok(Gray {
-            width,
-            height,
+        Gray {
+            width: img.width(),
+            height: img.height(),
             data,
-        })
+        }
     }
 
     /// Luma at (x, y).

@@ -3,6 +3,7 @@
 //! rectifying homography of a facade quadrilateral, and warping images and label maps through
 //! it (bilinear for photos, nearest for labels, so classes never blend).
 
+use image::RgbImage;
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 use super::gray::Gray;
@@ -144,6 +145,39 @@ pub fn warp_gray(src: &Gray, h: &Homography, width: u32, height: u32) -> Option<
         height,
         data,
     })
+}
+
+/// The colour photo warped like [`warp_gray`] (bilinear per channel); outside the source:
+/// black.
+pub fn warp_rgb(src: &RgbImage, h: &Homography, width: u32, height: u32) -> Option<RgbImage> {
+    let inv = h.inverse()?;
+    let (sw, sh) = (src.width() as f64, src.height() as f64);
+    let mut out = RgbImage::new(width, height);
+    for (x, y, px) in out.enumerate_pixels_mut() {
+        let Some([u, v]) = inv.apply([x as f64 + 0.5, y as f64 + 0.5]) else {
+            continue;
+        };
+        let (u, v) = (u - 0.5, v - 0.5);
+        if !(u >= -0.5 && v >= -0.5 && u <= sw - 0.5 && v <= sh - 0.5) {
+            continue;
+        }
+        let (u, v) = (u.clamp(0.0, sw - 1.0), v.clamp(0.0, sh - 1.0));
+        let (x0, y0) = (u.floor() as u32, v.floor() as u32);
+        let (x1, y1) = (
+            (x0 + 1).min(src.width() - 1),
+            (y0 + 1).min(src.height() - 1),
+        );
+        let (fx, fy) = (u - x0 as f64, v - y0 as f64);
+        for c in 0..3 {
+            let p = |x, y| src.get_pixel(x, y).0[c] as f64;
+            let val = p(x0, y0) * (1.0 - fx) * (1.0 - fy)
+                + p(x1, y0) * fx * (1.0 - fy)
+                + p(x0, y1) * (1.0 - fx) * fy
+                + p(x1, y1) * fx * fy;
+            px.0[c] = val.round().clamp(0.0, 255.0) as u8;
+        }
+    }
+    Some(out)
 }
 
 /// The label map warped like [`warp_gray`], nearest pixel; outside the source: ignore.

@@ -1,25 +1,35 @@
 //! Facades: reconstruction of building facades from photos (Müller, Zeng, Wonka & Van Gool
-//! 2007), and its evaluation against labelled photos. So far: the evaluation — label maps in
-//! canonical classes ([`labels`]), window instances of a label map ([`instances`]), the pixel
-//! and window-detection scores of a prediction ([`score`], protocol of
-//! `facade-reconstruction.md` §4) and folder reports ([`report`]); and the first analysis
-//! stage — grayscale photos ([`gray`]), mutual information of image bands
-//! ([`mutual_information`]) and the floor and tile repetition it reveals ([`repetition`]).
+//! 2007) and its evaluation against labelled photos. The pipeline ([`analysis`]): photo →
+//! rectification ([`segments`], [`vanishing`], [`homography`]) → floors and tiles by mutual
+//! information ([`mutual_information`], [`repetition`]) → the irreducible tile and its window
+//! ([`parse`]) → the shape grammar ([`grammar`], [`parse_grammar`]) → outputs ([`outputs`]:
+//! overlays ([`overlay`]), rule files, 3D facades ([`facade_mesh`], [`facade_export`])). The
+//! evaluation: label maps in canonical classes ([`labels`]), window instances ([`instances`]),
+//! pixel and window-detection scores ([`score`], protocol of `facade-reconstruction.md` §4) and
+//! folder reports ([`report`]).
 
+pub mod analysis;
 pub mod assignment;
 pub mod error;
+pub mod facade_export;
+pub mod facade_mesh;
 pub mod grammar;
 pub mod gray;
 pub mod homography;
 pub mod instances;
 pub mod labels;
 pub mod mutual_information;
+pub mod outputs;
+pub mod overlay;
 pub mod parse;
+pub mod parse_grammar;
 pub mod rect;
 pub mod repetition;
 pub mod report;
 pub mod score;
+pub mod segments;
 pub mod structure;
+pub mod vanishing;
 
 pub use error::FacadeError;
 pub use labels::{Class, LabelMap};

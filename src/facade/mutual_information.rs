@@ -15,6 +15,8 @@ pub struct MiWorkspace {
     joint: Vec<u32>,
     a: Vec<u32>,
     b: Vec<u32>,
+    /// Pixel pairs are sampled every `stride` rows and columns of the bands (1: all).
+    pub stride: usize,
 }
 
 impl Default for MiWorkspace {
@@ -23,6 +25,7 @@ impl Default for MiWorkspace {
             joint: vec![0; BINS * BINS],
             a: vec![0; BINS],
             b: vec![0; BINS],
+            stride: 1,
         }
     }
 }
@@ -33,13 +36,21 @@ fn bin(v: u8) -> usize {
 }
 
 impl MiWorkspace {
+    /// A workspace sampling every `stride`-th row and column of the bands.
+    pub fn with_stride(stride: usize) -> Self {
+        MiWorkspace {
+            stride: stride.max(1),
+            ..MiWorkspace::default()
+        }
+    }
+
     /// MI of the horizontal bands `[y1, y1 + h)` and `[y2, y2 + h)` (full width).
     pub fn rows(&mut self, img: &Gray, y1: u32, y2: u32, h: u32) -> f64 {
         let w = img.width as usize;
         self.clear();
-        for k in 0..h as usize {
+        for k in (0..h as usize).step_by(self.stride) {
             let (r1, r2) = ((y1 as usize + k) * w, (y2 as usize + k) * w);
-            for x in 0..w {
+            for x in (0..w).step_by(self.stride) {
                 self.add(img.data[r1 + x], img.data[r2 + x]);
             }
         }
@@ -50,9 +61,9 @@ impl MiWorkspace {
     pub fn columns(&mut self, img: &Gray, x1: u32, x2: u32, w: u32, y0: u32, y1: u32) -> f64 {
         let iw = img.width as usize;
         self.clear();
-        for y in y0 as usize..y1 as usize {
+        for y in (y0 as usize..y1 as usize).step_by(self.stride) {
             let row = y * iw;
-            for k in 0..w as usize {
+            for k in (0..w as usize).step_by(self.stride) {
                 self.add(
                     img.data[row + x1 as usize + k],
                     img.data[row + x2 as usize + k],

@@ -125,89 +125,45 @@ fn gaussian(v: &[f64], sigma: f64) -> Vec<f64> {
         .collect()
 }
 
-/// Relative scores `(h, S, S/S_own)` of every candidate period `min..=max`. Large images are
-/// searched at half resolution first (a band's MI hardly changes, the cost falls eightfold),
-/// and the scores are then recomputed at full resolution near the best half-resolution
-/// candidates only; candidates are scored in parallel, each independently, so the result does
-/// not depend on the thread count.
-fn period_scores(img: &Gray, axis: Axis, min: u32, max: u32) -> Vec<(u32, f64, f64)> {
-    let score = |img: &Gray, hs: &[u32]| -> Vec<(u32, f64, f64)> {
-        hs.par_iter()
-            .map_init(MiWorkspace::default, |ws, &h| {
+/// Relative scores `(h, S, S/S_own)` of the candidate periods `hs`, each scored
+/// independently (in parallel; the result does not depend on the thread count).
+fn period_scores(img: &Gray, axis: Axis, hs: &[u32]) -> Vec<(u32, f64, f64)> {
+    hs.par_iter()
+        .map_init(
+            || {
+                let large = img.width as u64 * img.height as u64 >= SPARSE_PIXELS;
+                MiWorkspace::with_stride(if large { 2 } else { 1 })
+            },
+            |ws, &h| {
                 let (s, own) = period_score(img, axis, h, ws);
                 (h, s, if own > 0.0 { s / own } else { 0.0 })
-            })
-            .collect()
-    };
-    let all: Vec<u32> = (min..=max).collect();
-    if (img.width as u64 * img.height as u64) < HALF_RES_PIXELS || min < 8 {
-        return score(img, &all);
-    }
-    let half = downsample(img);
-    let coarse = score(&half, &((min / 2).max(2)..=max / 2).collect::<Vec<_>>());
-    // full-resolution scores where the coarse ones are within reach of a peak: each coarse
-    // candidate h stands for 2h − 1 ..= 2h + 1; elsewhere the coarse score, interpolated
-    let mut out: Vec<(u32, f64, f64)> = all
-        .iter()
-        .map(|&h| {
-            let k =
-                ((h as f64 / 2.0).round() as u32).clamp(coarse[0].0, coarse[coarse.len() - 1].0);
-            let c = coarse[(k - coarse[0].0) as usize];
-            (h, c.1, c.2)
-        })
-        .collect();
-    let mut peaks: Vec<usize> = (1..coarse.len().saturating_sub(1))
-        .filter(|&k| coarse[k - 1].2 <= coarse[k].2 && coarse[k + 1].2 <= coarse[k].2)
-        .collect();
-    peaks.sort_by(|&a, &b| coarse[b].2.total_cmp(&coarse[a].2).then(a.cmp(&b)));
-    peaks.truncate(REFINED_PEAKS);
-    let mut refine: Vec<u32> = peaks
-        .iter()
-        .flat_map(|&k| (2 * coarse[k].0).saturating_sub(3)..=2 * coarse[k].0 + 3)
-        .filter(|h| (min..=max).contains(h))
-        .collect();
-    refine.sort_unstable();
-    refine.dedup();
-    for r in score(img, &refine) {
-        out[(r.0 - min) as usize] = r;
-    }
-    out
+            },
+        )
+        .collect()
 }
 
-/// Images of at least this many pixels are searched at half resolution first.
-const HALF_RES_PIXELS: u64 = 120_000;
-/// Coarse peaks refined at full resolution.
-const REFINED_PEAKS: usize = 6;
-
-/// The image at half resolution (2×2 means, rounded).
-pub fn downsample(img: &Gray) -> Gray {
-    let (w, h) = (img.width / 2, img.height / 2);
-    let mut data = Vec::with_capacity((w * h) as usize);
-    for y in 0..h {
-        for x in 0..w {
-            let s = img.at(2 * x, 2 * y) as u32
-                + img.at(2 * x + 1, 2 * y) as u32
-                + img.at(2 * x, 2 * y + 1) as u32
-                + img.at(2 * x + 1, 2 * y + 1) as u32;
-            data.push(((s + 2) / 4) as u8);
-        }
-    }
-    Gray {
-        width: w,
-        height: h,
-        data,
-    }
-}
+/// In images of at least this many pixels, MI samples every second row and column of the
+/// bands (a quarter of the pairs: still thousands per histogram of 32 × 32 bins).
+const SPARSE_PIXELS: u64 = 120_000;
 
 /// Finds the repetition of `img` along `axis` with a period in `min..=max` pixels (clamped
 /// so that two periods fit), or `None` when no period fits.
+/// Candidates are scored in parallel, each independently, so the result does not depend on
+/// the thread count.
 pub fn detect(img: &Gray, axis: Axis, min: u32, max: u32) -> Option<Repetition> {
     let n = extent(img, axis);
     let (min, max) = (min.max(2), max.min(n / 2));
     if min > max {
         return None;
     }
-    let scores = period_scores(img, axis, min, max);
+    let hs: Vec<u32> = (min..=max).collect();
+    let scores = period_scores(img, axis, &hs);
+    let (period, _, strength) = scores[choose_period(&scores)?];
+    Some(place(img, axis, period, strength))
+}
+
+/// Index of the period among the scored candidates (`None` without an interior peak).
+fn choose_period(scores: &[(u32, f64, f64)]) -> Option<usize> {
     // the period: a peak of the relative score standing out of its surroundings. Bands next to
     // each other look alike in any photo (sky above, road below, smooth shading), so the
     // score falls from the shortest period on whether or not the facade repeats: a period
@@ -236,8 +192,13 @@ pub fn detect(img: &Gray, axis: Axis, min: u32, max: u32) -> Option<Repetition> 
         .iter()
         .find(|p| p.1 >= HARMONIC_SHARE * best)
         .map(|p| p.0)?;
-    let (period, _, strength) = scores[k];
-    // splits: the phase whose comb of lines crosses the fewest edges
+    Some(k)
+}
+
+/// The repetition of `period` with its splits: the phase whose comb of lines crosses the
+/// fewest edges.
+fn place(img: &Gray, axis: Axis, period: u32, strength: f64) -> Repetition {
+    let n = extent(img, axis);
     let profile = edge_profile(img, axis, period as f64 / 16.0);
     let phase = (0..period)
         .min_by(|&a, &b| {
@@ -252,9 +213,9 @@ pub fn detect(img: &Gray, axis: Axis, min: u32, max: u32) -> Option<Repetition> 
         })
         .unwrap_or(0);
     let splits = (phase..n).step_by(period as usize).collect();
-    Some(Repetition {
+    Repetition {
         period,
         strength,
         splits,
-    })
+    }
 }

@@ -168,10 +168,23 @@ pub fn write_glb(
         mode: Valid(Mode::Triangles),
         targets: None,
     };
+    finish_glb(path, root, vec![primitive], bin)
+}
+
+/// Completes a glTF document whose buffers, views, accessors and materials are in `root`:
+/// one mesh of `primitives`, one node, one scene; then writes it as binary glTF (JSON and BIN
+/// chunks padded to 4 bytes) atomically. Shared by every `.glb` writer.
+pub(crate) fn finish_glb(
+    path: &Path,
+    mut root: Root,
+    primitives: Vec<Primitive>,
+    mut bin: Vec<u8>,
+) -> Result<(), GeometryError> {
+    let invalid = |m: String| GeometryError::Invalid(format!("{}: {m}", path.display()));
     let mesh = root.push(Mesh {
         extensions: None,
         extras: Default::default(),
-        primitives: vec![primitive],
+        primitives,
         weights: None,
     });
     let node = root.push(Node {
@@ -184,7 +197,6 @@ pub fn write_glb(
         nodes: vec![node],
     });
     root.scene = Some(scene);
-
     let mut json =
         gltf_json::serialize::to_vec(&root).map_err(|e| invalid(format!("glTF JSON: {e}")))?;
     json.resize(json.len().next_multiple_of(4), b' ');

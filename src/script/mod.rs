@@ -17,6 +17,7 @@ pub mod convert;
 pub mod docs;
 pub mod fabric;
 pub mod facade;
+pub mod facade_analysis;
 pub mod garment;
 pub mod kes;
 pub mod measure;
@@ -111,6 +112,7 @@ pub fn build_engine_with(limits: EngineLimits) -> Engine {
     output::register(&mut engine);
     measure::register(&mut engine);
     facade::register(&mut engine);
+    facade_analysis::register(&mut engine);
     kes::register(&mut engine);
     engine
 }

@@ -4,6 +4,7 @@
 #![allow(dead_code)]
 
 use emilion::facade::gray::Gray;
+use emilion::facade::{Class, LabelMap, Rect};
 
 pub const FLOOR: u32 = 57;
 pub const TILE: u32 = 43;
@@ -49,5 +50,41 @@ pub fn facade(width: u32, height: u32, seed: u64) -> Gray {
         width,
         height,
         data,
+    }
+}
+
+/// The synthetic facade's own label map: its windows (frames count as wall).
+pub fn window_truth(width: u32, height: u32) -> LabelMap {
+    let mut m = LabelMap::filled(width, height, Class::Wall);
+    for fy in 0..height.div_ceil(FLOOR) {
+        for tx in 0..width.div_ceil(TILE) {
+            m.paint(
+                &Rect {
+                    x0: tx * TILE + WIN_X.0,
+                    y0: fy * FLOOR + WIN_Y.0,
+                    x1: (tx * TILE + WIN_X.1).min(width),
+                    y1: (fy * FLOOR + WIN_Y.1).min(height),
+                },
+                Class::Window,
+            );
+        }
+    }
+    m
+}
+
+/// Uniform 8-bit noise (a picture with no structure), seeded.
+pub fn noise(width: u32, height: u32, seed: u64) -> Gray {
+    let mut s = seed;
+    Gray {
+        width,
+        height,
+        data: (0..width * height)
+            .map(|_| {
+                s = s
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (s >> 56) as u8
+            })
+            .collect(),
     }
 }

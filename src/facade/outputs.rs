@@ -1,0 +1,140 @@
+//! The files of one analysed photo: the diagnostic overlay (always, also when the analysis
+//! failed), the rectified photo, the parse as a LabelMeFacade-coloured label map, the rule
+//! file, and 3D facades (OBJ+MTL and glTF, textured with the rectified photo) generated from
+//! the grammar at the photo's width and at other widths.
+
+use std::io::Cursor;
+use std::path::{Path, PathBuf};
+
+use image::{ImageFormat, Rgb, RgbImage};
+
+use super::analysis::Analysis;
+use super::error::FacadeError;
+use super::facade_export::{write_glb_textured, write_obj_mtl};
+use super::facade_mesh::{build, check_closed, MeshParams};
+use super::labels::{Class, LabelMap};
+use super::overlay;
+use super::parse::rasterize;
+use super::segments;
+
+/// Storey height (m) a floor of the parse stands for when the facade is built in 3D.
+pub const STOREY_M: f64 = 3.2;
+
+/// What to write.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutputOptions {
+    /// Widths of the generated 3D facades, as multiples of the photo's (heights unchanged).
+    pub widths: Vec<f64>,
+    /// Heights of the generated 3D facades, as multiples of the photo's (widths unchanged).
+    pub heights: Vec<f64>,
+}
+
+impl Default for OutputOptions {
+    fn default() -> Self {
+        OutputOptions {
+            widths: vec![1.0, 0.75, 1.5],
+            heights: vec![],
+        }
+    }
+}
+
+fn file_err(path: &Path, message: impl ToString) -> FacadeError {
+    FacadeError::File {
+        path: path.to_path_buf(),
+        message: message.to_string(),
+    }
+}
+
+/// Writes a PNG atomically.
+pub fn write_png(path: &Path, img: &RgbImage) -> Result<(), FacadeError> {
+    let mut bytes = Vec::new();
+    img.write_to(&mut Cursor::new(&mut bytes), ImageFormat::Png)
+        .map_err(|e| file_err(path, e))?;
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| file_err(dir, e))?;
+    }
+    let tmp = path.with_extension("png.tmp");
+    std::fs::write(&tmp, &bytes).map_err(|e| file_err(&tmp, e))?;
+    std::fs::rename(&tmp, path).map_err(|e| file_err(path, e))
+}
+
+/// A label map in the LabelMeFacade colours (ignore black).
+pub fn label_picture(map: &LabelMap) -> RgbImage {
+    RgbImage::from_fn(map.width, map.height, |x, y| {
+        Rgb(match map.at(x, y) {
+            Class::Window => [0, 0, 128],
+            Class::Wall => [128, 0, 0],
+            Class::Door => [128, 128, 0],
+            Class::Background => [0, 128, 128],
+            Class::Balcony => [128, 0, 128],
+            Class::Ignore => [0, 0, 0],
+        })
+    })
+}
+
+/// Writes the outputs of `a` into `dir` as `STEM_overlay.png`, and when the parse succeeded
+/// `STEM_rectified.png`, `STEM_labels.png`, `STEM.cga` (the rules) and, per width and height
+/// factor, `STEM_wX.obj/.mtl/.glb`. Returns the files written. The overlay is written first,
+/// so it exists whatever fails later.
+pub fn write_outputs(
+    a: &Analysis,
+    dir: &Path,
+    stem: &str,
+    opts: &OutputOptions,
+) -> Result<Vec<PathBuf>, FacadeError> {
+    let mut written = Vec::new();
+    let overlay_path = dir.join(format!("{stem}_overlay.png"));
+    let (grammar, structure) = match &a.parse {
+        Ok(p) => p,
+        Err(_) => {
+            let segs = segments::detect(&a.gray);
+            write_png(&overlay_path, &overlay::failure(&a.rectified, &segs))?;
+            written.push(overlay_path);
+            return Ok(written);
+        }
+    };
+    let (w, h) = (a.gray.width as f64, a.gray.height as f64);
+    let leaves = grammar
+        .derive(w, h)
+        .map_err(|e| file_err(&dir.join(format!("{stem}.cga")), e))?;
+    let floor_rows: Vec<f64> = structure.floor_splits.iter().map(|&y| y as f64).collect();
+    let tile_cols: Vec<f64> = structure.tile_splits.iter().map(|&x| x as f64).collect();
+    write_png(
+        &overlay_path,
+        &overlay::structure(&a.rectified, &floor_rows, &tile_cols, &leaves),
+    )?;
+    written.push(overlay_path);
+    let rect_path = dir.join(format!("{stem}_rectified.png"));
+    write_png(&rect_path, &a.rectified)?;
+    written.push(rect_path.clone());
+    let labels_path = dir.join(format!("{stem}_labels.png"));
+    write_png(
+        &labels_path,
+        &label_picture(&rasterize(&leaves, a.gray.width, a.gray.height).labels),
+    )?;
+    written.push(labels_path);
+    let rules_path = dir.join(format!("{stem}.cga"));
+    std::fs::write(&rules_path, grammar.to_text()).map_err(|e| file_err(&rules_path, e))?;
+    written.push(rules_path);
+    let params = MeshParams::new(STOREY_M / structure.floor.max(1) as f64, (w, h));
+    let sizes = opts
+        .widths
+        .iter()
+        .map(|&f| (format!("w{f}"), f, 1.0))
+        .chain(opts.heights.iter().map(|&f| (format!("h{f}"), 1.0, f)));
+    for (tag, fx, fy) in sizes {
+        let obj = dir.join(format!("{stem}_{tag}.obj"));
+        let leaves = grammar
+            .derive(w * fx, h * fy)
+            .map_err(|e| file_err(&obj, e))?;
+        let mesh = build(&leaves, &params).map_err(|e| file_err(&obj, e))?;
+        check_closed(&mesh).map_err(|e| file_err(&obj, e))?;
+        write_obj_mtl(&obj, &mesh, Some(&rect_path))?;
+        let glb = obj.with_extension("glb");
+        write_glb_textured(&glb, &mesh, Some(&rect_path))?;
+        written.push(obj.with_extension("mtl"));
+        written.push(obj);
+        written.push(glb);
+    }
+    Ok(written)
+}
