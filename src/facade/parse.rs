@@ -52,6 +52,12 @@ pub struct Structure {
     pub origin: (u32, u32),
     /// Floors and tiles of the layout.
     pub count: (usize, usize),
+    /// Boundaries of the floors (`count.0 + 1` rows) and of the tiles (`count.1 + 1` columns),
+    /// photo pixels: the regular comb moved, floor by floor and column by column, to where
+    /// the windows of that floor or column stand out most (Müller's synchronisation).
+    pub row_starts: Vec<f64>,
+    /// See `row_starts`.
+    pub col_starts: Vec<f64>,
     /// Whether each cell (floor-major) holds the repeated tile: cells unlike the irreducible
     /// tile (another building, sky, a shop front) keep plain wall.
     pub present: Vec<bool>,
@@ -160,8 +166,10 @@ pub fn parse_region(
         tile = mean_of_cells(img, &kept, fh, tw);
         window = tile_window(&tile, tw, fh, priors.window);
     }
+    let (row_starts, col_starts) = synchronise(img, &rows, &cols, &mut present, &window, fh, tw);
     let t4 = Instant::now();
     let off = |v: &[u32], o: u32| v.iter().map(|&x| x + o).collect::<Vec<u32>>();
+    let offf = |v: Vec<f64>, o: u32| v.into_iter().map(|x| x + o as f64).collect::<Vec<f64>>();
     let structure = Structure {
         floor: fh,
         floor_splits: off(&floors.splits, region.y0),
@@ -170,6 +178,8 @@ pub fn parse_region(
         window,
         origin: (region.x0 + left as u32, region.y0 + top as u32),
         count: (nf, nt),
+        row_starts: offf(row_starts, region.y0),
+        col_starts: offf(col_starts, region.x0),
         present,
         strength: (floors.strength, tiles.strength),
         irreducible: tile,
@@ -181,6 +191,98 @@ pub fn parse_region(
         ],
     };
     Ok((grammar_of(&structure, full.width, full.height), structure))
+}
+
+/// Least difference (grey levels) between a window and its wall for a cell to keep its window.
+pub const MIN_WINDOW_CONTRAST: f64 = 10.0;
+
+/// How far (as a share of the cell) a window may move from the comb in synchronisation.
+const SYNC_REACH: f64 = 1.0 / 6.0;
+
+/// Local then global synchronisation of the windows: each kept cell's window is moved to the
+/// offset where it stands out most from its wall (within [`SYNC_REACH`] of the cell), then each
+/// floor takes the median vertical offset of its cells and each column the median horizontal
+/// one. Returns the floor and tile boundaries (image pixels) with the cells moved by those
+/// offsets; the regular comb when the moved cells would no longer hold their window.
+fn synchronise(
+    img: &Gray,
+    rows: &[(u32, u32)],
+    cols: &[(u32, u32)],
+    present: &mut [bool],
+    window: &Rect,
+    fh: u32,
+    tw: u32,
+) -> (Vec<f64>, Vec<f64>) {
+    let (nf, nt) = (rows.len(), cols.len());
+    let comb = |v: &[(u32, u32)]| -> Vec<f64> {
+        let mut b: Vec<f64> = v.iter().map(|c| c.0 as f64).collect();
+        b.push(v.last().map_or(0.0, |c| c.1 as f64));
+        b
+    };
+    let (rx, ry) = (
+        (tw as f64 * SYNC_REACH) as i64,
+        (fh as f64 * SYNC_REACH) as i64,
+    );
+    let (w, h) = (img.width as i64, img.height as i64);
+    let mut dx: Vec<Vec<i64>> = vec![Vec::new(); nt];
+    let mut dy: Vec<Vec<i64>> = vec![Vec::new(); nf];
+    let win = window_in(window, fh);
+    for (i, r) in rows.iter().enumerate() {
+        for (j, c) in cols.iter().enumerate() {
+            if !present[i * nt + j] {
+                continue;
+            }
+            let mut best = (f64::NEG_INFINITY, 0, 0);
+            for oy in -ry..=ry {
+                for ox in -rx..=rx {
+                    let (x0, y0) = (c.0 as i64 + ox, r.0 as i64 + oy);
+                    if x0 < 0 || y0 < 0 || x0 + tw as i64 > w || y0 + fh as i64 > h {
+                        continue;
+                    }
+                    let k = contrast(&img.data, img.width, x0 as u32, y0 as u32, tw, &win).abs();
+                    // nearer offsets win ties
+                    if k > best.0 + 1e-9 * k.abs() {
+                        best = (k, ox, oy);
+                    }
+                }
+            }
+            if best.0 < MIN_WINDOW_CONTRAST {
+                present[i * nt + j] = false;
+                continue;
+            }
+            dx[j].push(best.1);
+            dy[i].push(best.2);
+        }
+    }
+    let median = |v: &mut Vec<i64>| -> i64 {
+        if v.is_empty() {
+            return 0;
+        }
+        v.sort_unstable();
+        v[v.len() / 2]
+    };
+    let mdx: Vec<i64> = dx.iter_mut().map(median).collect();
+    let mdy: Vec<i64> = dy.iter_mut().map(median).collect();
+    let moved = |v: &[(u32, u32)], d: &[i64], size: u32| -> Vec<f64> {
+        let mut b: Vec<f64> = v
+            .iter()
+            .zip(d)
+            .map(|(c, o)| (c.0 as i64 + o) as f64)
+            .collect();
+        b.push(b.last().copied().unwrap_or(0.0) + size as f64);
+        b
+    };
+    let (rs, cs) = (moved(rows, &mdy, fh), moved(cols, &mdx, tw));
+    let fits = |b: &[f64], need: u32, n: i64| {
+        b.first().is_some_and(|&f| f >= 0.0)
+            && b.last().is_some_and(|&l| l <= n as f64)
+            && b.windows(2).all(|p| p[1] - p[0] >= need as f64)
+    };
+    if fits(&rs, window.y1, h) && fits(&cs, window.x1, w) && nf > 0 && nt > 0 {
+        (rs, cs)
+    } else {
+        (comb(rows), comb(cols))
+    }
 }
 
 /// The pixels of `r`.

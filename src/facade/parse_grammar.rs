@@ -1,152 +1,177 @@
 //! The grammar of a parse ([`super::parse::Structure`]): margins around the floors × tiles
-//! layout, each cell holding the irreducible tile (a window with wall around it) or plain wall,
-//! written as split/repeat rules ([`super::grammar`]) that regenerate the parse exactly at the
-//! photo's size and adapt to other sizes (floors and tiles repeat, windows keep their size).
+//! layout; each floor a band of windows between wall above and below, the band cut into
+//! cells that hold a window between wall (or plain wall where the cell has none), written as
+//! split/repeat rules ([`super::grammar`]) that regenerate the parse exactly at the photo's
+//! size and adapt to other sizes (floors and tiles repeat or stretch, windows keep their size).
+
+use std::collections::BTreeMap;
 
 use super::grammar::{Body, Dir, Grammar, Size};
 use super::labels::Class;
 use super::parse::Structure;
 
-/// The grammar of a parse: margins around the floors × tiles layout; in each cell either the
-/// tile (a window with wall around it) or plain wall. Floors that all hold the tile repeat
-/// along x; identical floors repeat along y; otherwise each floor pattern gets its own rule.
-/// Facade units are the photo's pixels.
+/// A rule name for `key` among the variants seen so far: `base` for the first, `base2`, … for
+/// the others.
+fn variant<K: PartialEq>(seen: &mut Vec<K>, key: K, base: &str) -> String {
+    let k = match seen.iter().position(|s| *s == key) {
+        Some(k) => k,
+        None => {
+            seen.push(key);
+            seen.len() - 1
+        }
+    };
+    if k == 0 {
+        base.to_string()
+    } else {
+        format!("{base}{}", k + 1)
+    }
+}
+
+/// The grammar of a parse. Facade units are the photo's pixels.
 pub fn grammar_of(s: &Structure, width: u32, height: u32) -> Grammar {
     let (w, h) = (width as f64, height as f64);
     let (fh, tw) = (s.floor as f64, s.tile as f64);
     let (nf, nt) = s.count;
-    let (left, top) = (s.origin.0 as f64, s.origin.1 as f64);
-    let (floors_h, tiles_w) = (nf as f64 * fh, nt as f64 * tw);
-    let (bottom, right) = (h - top - floors_h, w - left - tiles_w);
-    let win = s.window;
-    let (win_w, win_h) = ((win.x1 - win.x0) as f64, (win.y1 - win.y0) as f64);
-    let leaf = |c: Class| Body::Leaf(c);
-    let split = |dir: Dir, parts: Vec<(Size, String)>| Body::Split { dir, parts };
-    let mut rules = std::collections::BTreeMap::new();
-    rules.insert("Wall".to_string(), leaf(Class::Wall));
-    let grammar = |rules| Grammar {
+    let (rs, cs) = (&s.row_starts, &s.col_starts);
+    let mut rules = BTreeMap::new();
+    let wall = || Body::Leaf(Class::Wall);
+    rules.insert("Wall".to_string(), wall());
+    let done = |rules| Grammar {
         rules,
         axiom: "Facade".into(),
         size: (w, h),
     };
-    if nf == 0 || nt == 0 || !s.present.iter().any(|&p| p) {
-        rules.insert("Facade".to_string(), leaf(Class::Wall));
-        return grammar(rules);
+    if nf == 0
+        || nt == 0
+        || rs.len() != nf + 1
+        || cs.len() != nt + 1
+        || !s.present.iter().any(|&p| p)
+    {
+        rules.insert("Facade".to_string(), wall());
+        return done(rules);
     }
+    let split = |dir: Dir, parts: Vec<(Size, String)>| Body::Split { dir, parts };
+    let win = s.window;
+    let (win_w, win_h) = ((win.x1 - win.x0) as f64, (win.y1 - win.y0) as f64);
+    let heights: Vec<f64> = rs.windows(2).map(|p| p[1] - p[0]).collect();
+    let widths: Vec<f64> = cs.windows(2).map(|p| p[1] - p[0]).collect();
+    let uniform_w = widths.iter().all(|&x| x == tw);
     rules.insert(
         "Facade".to_string(),
         split(
             Dir::Y,
             vec![
-                (Size::Fixed(top), "Wall".into()),
-                (Size::Floating(floors_h), "Floors".into()),
-                (Size::Fixed(bottom), "Wall".into()),
+                (Size::Fixed(rs[0]), "Wall".into()),
+                (Size::Floating(rs[nf] - rs[0]), "Floors".into()),
+                (Size::Fixed(h - rs[nf]), "Wall".into()),
             ],
         ),
     );
-    // one rule per distinct floor pattern
-    let patterns: Vec<&[bool]> = s.present.chunks(nt).collect();
-    let mut names: Vec<String> = Vec::new();
-    let mut seen: Vec<&[bool]> = Vec::new();
-    for p in &patterns {
-        let k = match seen.iter().position(|q| q == p) {
-            Some(k) => k,
-            None => {
-                seen.push(p);
-                seen.len() - 1
+    rules.insert("Window".to_string(), Body::Leaf(Class::Window));
+    // one window-cell rule per distinct cell width: wall, the window, wall
+    let mut tiles_seen: Vec<u64> = Vec::new();
+    let tile_names: Vec<String> = widths
+        .iter()
+        .map(|&wj| {
+            let name = variant(&mut tiles_seen, wj.to_bits(), "Tile");
+            rules.entry(name.clone()).or_insert_with(|| {
+                split(
+                    Dir::X,
+                    vec![
+                        (Size::Floating(win.x0 as f64), "Wall".into()),
+                        (Size::Fixed(win_w), "Window".into()),
+                        (Size::Floating(wj - win.x1 as f64), "Wall".into()),
+                    ],
+                )
+            });
+            name
+        })
+        .collect();
+    // one band rule per distinct pattern of cells with and without a window
+    let mut rows_seen: Vec<&[bool]> = Vec::new();
+    let mut floors_seen: Vec<(u64, String)> = Vec::new();
+    let mut floor_names = Vec::with_capacity(nf);
+    for (i, pattern) in s.present.chunks(nt).enumerate() {
+        let band = if pattern.iter().all(|&p| !p) {
+            None
+        } else {
+            let name = variant(&mut rows_seen, pattern, "Band");
+            if !rules.contains_key(&name) {
+                let cells = format!("{name}Cells");
+                let cells_body = if uniform_w && pattern.iter().all(|&p| p) {
+                    Body::Repeat {
+                        dir: Dir::X,
+                        size: tw,
+                        rule: "Tile".into(),
+                    }
+                } else {
+                    split(
+                        Dir::X,
+                        pattern
+                            .iter()
+                            .zip(&widths)
+                            .zip(&tile_names)
+                            .map(|((&p, &wj), t)| {
+                                (
+                                    Size::Floating(wj),
+                                    if p { t.clone() } else { "Wall".into() },
+                                )
+                            })
+                            .collect(),
+                    )
+                };
+                rules.insert(cells.clone(), cells_body);
+                rules.insert(
+                    name.clone(),
+                    split(
+                        Dir::X,
+                        vec![
+                            (Size::Fixed(cs[0]), "Wall".into()),
+                            (Size::Floating(cs[nt] - cs[0]), cells),
+                            (Size::Fixed(w - cs[nt]), "Wall".into()),
+                        ],
+                    ),
+                );
+            }
+            Some(name)
+        };
+        let floor = match band {
+            None => "Wall".to_string(),
+            Some(band) => {
+                let hi = heights[i];
+                let name = variant(&mut floors_seen, (hi.to_bits(), band.clone()), "Floor");
+                rules.entry(name.clone()).or_insert_with(|| {
+                    split(
+                        Dir::Y,
+                        vec![
+                            (Size::Floating(win.y0 as f64), "Wall".into()),
+                            (Size::Fixed(win_h), band),
+                            (Size::Floating(hi - win.y1 as f64), "Wall".into()),
+                        ],
+                    )
+                });
+                name
             }
         };
-        let name = if p.iter().all(|&c| c) {
-            "Floor".to_string()
-        } else if p.iter().all(|&c| !c) {
-            "Wall".to_string()
-        } else {
-            format!("Floor{k}")
-        };
-        names.push(name);
+        floor_names.push(floor);
     }
-    if names.iter().all(|n| n == &names[0]) {
-        rules.insert(
-            "Floors".to_string(),
+    let floors =
+        if heights.iter().all(|&x| x == fh) && floor_names.iter().all(|n| n == &floor_names[0]) {
             Body::Repeat {
                 dir: Dir::Y,
                 size: fh,
-                rule: names[0].clone(),
-            },
-        );
-    } else {
-        rules.insert(
-            "Floors".to_string(),
+                rule: floor_names[0].clone(),
+            }
+        } else {
             split(
                 Dir::Y,
-                names
-                    .iter()
-                    .map(|n| (Size::Floating(fh), n.clone()))
+                floor_names
+                    .into_iter()
+                    .zip(&heights)
+                    .map(|(n, &hi)| (Size::Floating(hi), n))
                     .collect(),
-            ),
-        );
-    }
-    for (p, name) in patterns.iter().zip(&names) {
-        if rules.contains_key(name) {
-            continue;
-        }
-        let tiles = if p.iter().all(|&c| c) {
-            rules.insert(
-                "Tiles".to_string(),
-                Body::Repeat {
-                    dir: Dir::X,
-                    size: tw,
-                    rule: "Tile".into(),
-                },
-            );
-            "Tiles".to_string()
-        } else {
-            let row = format!("{name}Cells");
-            rules.insert(
-                row.clone(),
-                split(
-                    Dir::X,
-                    p.iter()
-                        .map(|&c| (Size::Floating(tw), if c { "Tile" } else { "Wall" }.into()))
-                        .collect(),
-                ),
-            );
-            row
+            )
         };
-        rules.insert(
-            name.clone(),
-            split(
-                Dir::X,
-                vec![
-                    (Size::Fixed(left), "Wall".into()),
-                    (Size::Floating(tiles_w), tiles),
-                    (Size::Fixed(right), "Wall".into()),
-                ],
-            ),
-        );
-    }
-    rules.insert(
-        "Tile".to_string(),
-        split(
-            Dir::X,
-            vec![
-                (Size::Floating(win.x0 as f64), "Wall".into()),
-                (Size::Fixed(win_w), "Column".into()),
-                (Size::Floating(tw - win.x1 as f64), "Wall".into()),
-            ],
-        ),
-    );
-    rules.insert(
-        "Column".to_string(),
-        split(
-            Dir::Y,
-            vec![
-                (Size::Floating(win.y0 as f64), "Wall".into()),
-                (Size::Fixed(win_h), "Window".into()),
-                (Size::Floating(fh - win.y1 as f64), "Wall".into()),
-            ],
-        ),
-    );
-    rules.insert("Window".to_string(), leaf(Class::Window));
-    grammar(rules)
+    rules.insert("Floors".to_string(), floors);
+    done(rules)
 }
