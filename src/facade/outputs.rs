@@ -10,12 +10,14 @@ use image::{ImageFormat, Rgb, RgbImage};
 
 use super::analysis::Analysis;
 use super::error::FacadeError;
-use super::facade_export::{write_glb_textured, write_obj_mtl};
-use super::facade_mesh::{build, check_closed, MeshParams};
+use super::facade_export::{appearance, write_glb_textured, write_obj_mtl};
+use super::facade_mesh::{build, check_closed, FacadeMesh, MeshParams};
 use super::labels::{Class, LabelMap};
 use super::overlay;
 use super::parse::rasterize;
 use super::segments;
+use crate::geometry::Vec3;
+use crate::render::{render_png, Camera, RenderMesh};
 
 /// Storey height (m) a floor of the parse stands for when the facade is built in 3D.
 pub const STOREY_M: f64 = 3.2;
@@ -72,9 +74,49 @@ pub fn label_picture(map: &LabelMap) -> RgbImage {
     })
 }
 
+/// Renders a generated facade (flat colours per surface) from the front, a little to the right
+/// and above, to a PNG.
+pub fn render_facade(path: &Path, mesh: &FacadeMesh) -> Result<(), FacadeError> {
+    let (mut lo, mut hi) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
+    for p in &mesh.positions {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    if !(lo.iter().chain(hi.iter()).all(|c| c.is_finite())) {
+        return Err(file_err(path, "nothing to render: empty facade"));
+    }
+    let (size, center) = (hi - lo, 0.5 * (lo + hi));
+    let (width, height) = (800u32, 600u32);
+    let fov: f64 = 40.0;
+    // far enough that the facade's width and height fit with a margin
+    let fit = (size.y / (0.5 * fov.to_radians()).tan())
+        .max(size.x / (0.5 * fov.to_radians()).tan() * height as f64 / width as f64)
+        * 0.6;
+    let camera = Camera {
+        eye: center + Vec3::new(0.35, 0.2, 1.0).normalize() * (fit + size.z),
+        target: center,
+        up: Vec3::y(),
+        fov_y_deg: fov,
+        width,
+        height,
+    };
+    let meshes: Vec<RenderMesh> = mesh
+        .groups
+        .iter()
+        .map(|g| RenderMesh {
+            positions: &mesh.positions,
+            triangles: &mesh.triangles[g.triangles.clone()],
+            color: appearance(g.surface)
+                .srgb
+                .map(|c| (c * 255.0).round().clamp(0.0, 255.0) as u8),
+        })
+        .collect();
+    render_png(path, &meshes, &camera).map_err(|e| file_err(path, e))
+}
+
 /// Writes the outputs of `a` into `dir` as `STEM_overlay.png`, and when the parse succeeded
 /// `STEM_rectified.png`, `STEM_labels.png`, `STEM.cga` (the rules) and, per width and height
-/// factor, `STEM_wX.obj/.mtl/.glb`. Returns the files written. The overlay is written first,
+/// factor, `STEM_wX.obj/.mtl/.glb` and a render `STEM_wX.png`. Returns the files written. The overlay is written first,
 /// so it exists whatever fails later.
 pub fn write_outputs(
     a: &Analysis,
@@ -130,6 +172,9 @@ pub fn write_outputs(
         let mesh = build(&leaves, &params).map_err(|e| file_err(&obj, e))?;
         check_closed(&mesh).map_err(|e| file_err(&obj, e))?;
         write_obj_mtl(&obj, &mesh, Some(&rect_path))?;
+        let png = obj.with_extension("png");
+        render_facade(&png, &mesh)?;
+        written.push(png);
         let glb = obj.with_extension("glb");
         write_glb_textured(&glb, &mesh, Some(&rect_path))?;
         written.push(obj.with_extension("mtl"));

@@ -227,7 +227,8 @@ agrees with the parse (1 = lossless); 0 when the parse failed.",
         "Writes STEM_overlay.png (always: the structure over the rectified photo, or the
 segments seen when the analysis failed) and, after a parse, STEM_rectified.png,
 STEM_labels.png, STEM.cga (the rules) and 3D facades at 1×, 0.75× and 1.5× the width
-(STEM_w1.obj/.mtl/.glb, …, textured with the rectified photo). Returns the paths.",
+(STEM_w1.obj/.mtl/.glb, …, textured with the rectified photo) with a render of each
+(STEM_w1.png, …). Returns the paths.",
         |a: &mut FacadeAnalysis, dir: &str, stem: &str| -> RResult<Array> {
             let files = write_outputs(&a.0, Path::new(dir), stem, &OutputOptions::default())
                 .map_err(|e| rt_err(e.to_string()))?;
