@@ -20,3 +20,4 @@ pub mod render;
 pub mod scenes;
 #[cfg(feature = "scripting")]
 pub mod script;
+pub mod tracking;
