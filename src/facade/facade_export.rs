@@ -10,20 +10,20 @@ use std::fmt::Write as _;
 use std::io::Cursor;
 use std::path::{Component, Path};
 
-use gltf_json::accessor::{ComponentType, GenericComponentType, Type};
-use gltf_json::buffer::{Buffer, Target, View};
+use gltf_json::accessor::{ComponentType, Type};
+use gltf_json::buffer::Target;
 use gltf_json::image::MimeType;
 use gltf_json::material::{PbrBaseColorFactor, PbrMetallicRoughness, StrengthFactor};
 use gltf_json::mesh::{Mode, Primitive, Semantic};
 use gltf_json::texture::{Info, MagFilter, MinFilter, Sampler, WrappingMode};
-use gltf_json::validation::{Checked::Valid, USize64};
-use gltf_json::{Accessor, Image, Index, Material, Root, Texture};
+use gltf_json::validation::Checked::Valid;
+use gltf_json::{Accessor, Image, Material, Texture};
 
 use super::error::FacadeError;
 use super::facade_mesh::{FacadeMesh, Surface};
 use super::labels::Class;
 use crate::geometry::files::write_atomic;
-use crate::geometry::gltf::finish_glb;
+use crate::geometry::gltf::{finish_glb, glb_accessor, glb_root, glb_view};
 use crate::geometry::GeometryError;
 
 /// How a surface looks when it carries no photo (and how it reflects either way).
@@ -227,42 +227,9 @@ pub fn write_glb_textured(
         bin.extend_from_slice(bytes);
     }
 
-    let mut root = Root {
-        asset: gltf_json::Asset {
-            generator: Some(format!("emilion {}", env!("CARGO_PKG_VERSION"))),
-            ..Default::default()
-        },
-        ..Default::default()
-    };
-    let buffer = root.push(Buffer {
-        byte_length: USize64(bin.len() as u64),
-        uri: None,
-        extensions: None,
-        extras: Default::default(),
-    });
-    let view = |offset: u64, length: u64, target: Option<Target>| View {
-        buffer,
-        byte_length: USize64(length),
-        byte_offset: Some(USize64(offset)),
-        byte_stride: None,
-        target: target.map(Valid),
-        extensions: None,
-        extras: Default::default(),
-    };
-    let accessor =
-        |view: Index<View>, count: u64, component: ComponentType, type_: Type| Accessor {
-            buffer_view: Some(view),
-            byte_offset: Some(USize64(0)),
-            count: USize64(count),
-            component_type: Valid(GenericComponentType(component)),
-            extensions: None,
-            extras: Default::default(),
-            type_: Valid(type_),
-            min: None,
-            max: None,
-            normalized: false,
-            sparse: None,
-        };
+    let (mut root, buffer) = glb_root(bin.len());
+    let view = |offset, length, target| glb_view(buffer, offset, length, target);
+    let accessor = glb_accessor;
     let pos_view = root.push(view(0, 12 * n, Some(Target::ArrayBuffer)));
     let nrm_view = root.push(view(12 * n, 12 * n, Some(Target::ArrayBuffer)));
     let uv_view = root.push(view(24 * n, 8 * n, Some(Target::ArrayBuffer)));

@@ -91,45 +91,12 @@ pub fn write_glb(
     }
     let (pos_len, idx_len) = (12 * n as u64, 12 * triangles.len() as u64);
 
-    let mut root = Root {
-        asset: gltf_json::Asset {
-            generator: Some(format!("emilion {}", env!("CARGO_PKG_VERSION"))),
-            ..Default::default()
-        },
-        ..Default::default()
-    };
-    let buffer = root.push(Buffer {
-        byte_length: USize64(bin.len() as u64),
-        uri: None,
-        extensions: None,
-        extras: Default::default(),
-    });
-    let view = |offset: u64, length: u64, target: Target| View {
-        buffer,
-        byte_length: USize64(length),
-        byte_offset: Some(USize64(offset)),
-        byte_stride: None,
-        target: Some(Valid(target)),
-        extensions: None,
-        extras: Default::default(),
-    };
+    let (mut root, buffer) = glb_root(bin.len());
+    let view = |offset, length, target| glb_view(buffer, offset, length, Some(target));
     let pos_view = root.push(view(0, pos_len, Target::ArrayBuffer));
     let nrm_view = root.push(view(pos_len, pos_len, Target::ArrayBuffer));
     let idx_view = root.push(view(2 * pos_len, idx_len, Target::ElementArrayBuffer));
-    let accessor =
-        |view: Index<View>, count: u64, component: ComponentType, type_: Type| Accessor {
-            buffer_view: Some(view),
-            byte_offset: Some(USize64(0)),
-            count: USize64(count),
-            component_type: Valid(GenericComponentType(component)),
-            extensions: None,
-            extras: Default::default(),
-            type_: Valid(type_),
-            min: None,
-            max: None,
-            normalized: false,
-            sparse: None,
-        };
+    let accessor = glb_accessor;
     let pos_acc = root.push(Accessor {
         min: Some(serde_json::json!(lo)),
         max: Some(serde_json::json!(hi)),
@@ -169,6 +136,65 @@ pub fn write_glb(
         targets: None,
     };
     finish_glb(path, root, vec![primitive], bin)
+}
+
+/// An empty glTF document (its generator set) holding one buffer of `len` bytes, the binary
+/// chunk [`finish_glb`] writes.
+pub(crate) fn glb_root(len: usize) -> (Root, Index<Buffer>) {
+    let mut root = Root {
+        asset: gltf_json::Asset {
+            generator: Some(format!("emilion {}", env!("CARGO_PKG_VERSION"))),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let buffer = root.push(Buffer {
+        byte_length: USize64(len as u64),
+        uri: None,
+        extensions: None,
+        extras: Default::default(),
+    });
+    (root, buffer)
+}
+
+/// A view of `length` bytes at `offset` of `buffer`.
+pub(crate) fn glb_view(
+    buffer: Index<Buffer>,
+    offset: u64,
+    length: u64,
+    target: Option<Target>,
+) -> View {
+    View {
+        buffer,
+        byte_length: USize64(length),
+        byte_offset: Some(USize64(offset)),
+        byte_stride: None,
+        target: target.map(Valid),
+        extensions: None,
+        extras: Default::default(),
+    }
+}
+
+/// A tightly packed accessor of `count` elements at the start of `view`, without bounds.
+pub(crate) fn glb_accessor(
+    view: Index<View>,
+    count: u64,
+    component: ComponentType,
+    type_: Type,
+) -> Accessor {
+    Accessor {
+        buffer_view: Some(view),
+        byte_offset: Some(USize64(0)),
+        count: USize64(count),
+        component_type: Valid(GenericComponentType(component)),
+        extensions: None,
+        extras: Default::default(),
+        type_: Valid(type_),
+        min: None,
+        max: None,
+        normalized: false,
+        sparse: None,
+    }
 }
 
 /// Completes a glTF document whose buffers, views, accessors and materials are in `root`:
