@@ -5,7 +5,6 @@
 mod common;
 
 use common::{facade, FLOOR, TILE, WIN_X, WIN_Y};
-use emilion::facade::gray::Gray;
 use emilion::facade::repetition::{detect, Axis};
 
 #[test]
@@ -32,20 +31,7 @@ fn floors_and_tiles_of_a_synthetic_facade_are_found() {
 
 #[test]
 fn noise_has_no_strong_repetition() {
-    let mut s = 99u64;
-    let data = (0..200 * 160)
-        .map(|_| {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 56) as u8
-        })
-        .collect();
-    let img = Gray {
-        width: 200,
-        height: 160,
-        data,
-    };
+    let img = common::noise(200, 160, 99);
     let r = detect(&img, Axis::Rows, 10, 70).expect("some period");
     assert!(r.strength < 0.2, "{r:?}");
 }

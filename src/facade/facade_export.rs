@@ -23,7 +23,7 @@ use super::error::FacadeError;
 use super::facade_mesh::{FacadeMesh, Surface};
 use super::labels::Class;
 use crate::geometry::files::write_atomic;
-use crate::geometry::gltf::{finish_glb, glb_accessor, glb_root, glb_view};
+use crate::geometry::gltf::{f32_bounds, finish_glb, glb_accessor, glb_root, glb_view};
 use crate::geometry::GeometryError;
 
 /// How a surface looks when it carries no photo (and how it reflects either way).
@@ -195,18 +195,7 @@ pub fn write_glb_textured(
             indices.push(id);
         }
     }
-    if let Some(i) = p32.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
-        return Err(invalid(format!(
-            "vertex {i} is beyond single-precision range"
-        )));
-    }
-    let (mut lo, mut hi) = (p32[0], p32[0]);
-    for p in &p32 {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
+    let (lo, hi) = f32_bounds(&p32).map_err(invalid)?;
 
     // Binary chunk: positions, normals, texture coordinates, indices, image; every piece is
     // a multiple of 4 bytes long except the image, which comes last.

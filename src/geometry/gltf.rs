@@ -54,18 +54,7 @@ pub fn write_glb(
         .iter()
         .map(|p| [p.x as f32, p.y as f32, p.z as f32])
         .collect();
-    if let Some(i) = p32.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
-        return Err(invalid(format!(
-            "vertex {i} is beyond single-precision range"
-        )));
-    }
-    let (mut lo, mut hi) = (p32[0], p32[0]);
-    for p in &p32 {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
+    let (lo, hi) = f32_bounds(&p32).map_err(invalid)?;
     let normals = vertex_normals(positions, triangles);
 
     // Binary chunk: positions, normals, indices, each 4-byte aligned by construction.
@@ -136,6 +125,23 @@ pub fn write_glb(
         targets: None,
     };
     finish_glb(path, root, vec![primitive], bin)
+}
+
+/// The bounds (glTF's accessor min and max) of single-precision positions, or which vertex
+/// is beyond single-precision range. `p32` must not be empty.
+pub(crate) fn f32_bounds(p32: &[[f32; 3]]) -> Result<([f32; 3], [f32; 3]), String> {
+    if let Some(i) = p32.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+        return Err(format!("vertex {i} is beyond single-precision range"));
+    }
+    let first = p32.first().copied().unwrap_or([0.0; 3]);
+    let (mut lo, mut hi) = (first, first);
+    for p in p32 {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    Ok((lo, hi))
 }
 
 /// An empty glTF document (its generator set) holding one buffer of `len` bytes, the binary
