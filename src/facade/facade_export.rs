@@ -23,7 +23,9 @@ use super::error::FacadeError;
 use super::facade_mesh::{FacadeMesh, Surface};
 use super::labels::Class;
 use crate::geometry::files::write_atomic;
-use crate::geometry::gltf::{f32_bounds, finish_glb, glb_accessor, glb_root, glb_view};
+use crate::geometry::gltf::{
+    f32_bounds, finish_glb, glb_accessor, glb_root, glb_view, linear_from_srgb,
+};
 use crate::geometry::GeometryError;
 
 /// How a surface looks when it carries no photo (and how it reflects either way).
@@ -269,7 +271,7 @@ pub fn write_glb_textured(
         let [r, gr, b] = if tex.is_some() {
             [1.0; 3]
         } else {
-            look.srgb.map(srgb_to_linear)
+            look.srgb.map(linear_from_srgb)
         };
         let material = root.push(Material {
             pbr_metallic_roughness: PbrMetallicRoughness {
@@ -366,15 +368,6 @@ fn geometry_err(path: &Path, e: GeometryError) -> FacadeError {
     match e {
         GeometryError::Io { path, source } => file_err(&path, source.to_string()),
         other => file_err(path, other.to_string()),
-    }
-}
-
-/// An sRGB component in [0, 1] to linear (glTF colour factors are linear).
-fn srgb_to_linear(c: f64) -> f64 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
     }
 }
 

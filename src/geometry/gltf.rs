@@ -251,7 +251,11 @@ pub(crate) fn finish_glb(
 
 /// Converts an 8-bit sRGB component to linear (glTF colour factors are linear).
 fn srgb_to_linear(c: u8) -> f32 {
-    let c = f32::from(c) / 255.0;
+    linear_from_srgb(f64::from(c) / 255.0) as f32
+}
+
+/// An sRGB component in [0, 1] to linear light.
+pub(crate) fn linear_from_srgb(c: f64) -> f64 {
     if c <= 0.04045 {
         c / 12.92
     } else {
