@@ -93,7 +93,7 @@ pub struct CompressionRelease {
     busy: Vec<bool>,
     /// Scratch: compressed springs (strain, spring).
     order: Vec<(f64, usize)>,
-    rng: u64,
+    rng: crate::geometry::SplitMix64,
     /// Releases performed so far.
     pub releases: u64,
 }
@@ -119,18 +119,13 @@ impl CompressionRelease {
             held: Vec::new(),
             busy: vec![false; nx * ny],
             order: Vec::new(),
-            rng: options.seed,
+            rng: crate::geometry::SplitMix64::new(options.seed),
             releases: 0,
         })
     }
 
     fn random_bit(&mut self) -> bool {
-        // SplitMix64
-        self.rng = self.rng.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.rng;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        (z ^ (z >> 31)) & 1 == 1
+        self.rng.bit()
     }
 
     /// Marks particle `m` and its eight grid neighbours busy.

@@ -266,15 +266,9 @@ impl ClothModel {
     /// ±`amplitude`/2: the imperfection that lets a flat cloth pushed in its plane buckle.
     /// The same seed gives the same positions, bit for bit (SplitMix64).
     pub fn perturb(&mut self, dir: crate::geometry::Vec3, amplitude: f64, seed: u64) {
-        let mut state = seed;
+        let mut rng = crate::geometry::SplitMix64::new(seed);
         for p in &mut self.mesh.positions {
-            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = state;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            z ^= z >> 31;
-            let u = (z >> 11) as f64 / (1u64 << 53) as f64;
-            *p += dir * (amplitude * (u - 0.5));
+            *p += dir * (amplitude * (rng.uniform() - 0.5));
         }
     }
 

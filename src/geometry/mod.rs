@@ -8,6 +8,7 @@ pub mod gltf;
 pub mod grid;
 pub mod mesh;
 pub mod obj;
+pub mod random;
 pub mod topology;
 
 pub use error::GeometryError;
@@ -15,6 +16,7 @@ pub use gltf::write_glb;
 pub use grid::grid_mesh;
 pub use mesh::TriMesh;
 pub use obj::{read_obj, read_obj_surface, write_obj};
+pub use random::SplitMix64;
 pub use topology::{Edge, Hinge, Topology};
 
 /// Three-vector of f64, SI units (metres, m/s, newtons).

@@ -25,6 +25,8 @@ pub mod output;
 pub mod repl;
 pub mod run;
 pub mod sim;
+pub mod tracking;
+pub mod tracking_sequence;
 
 use rhai::{Dynamic, Engine};
 
@@ -113,6 +115,8 @@ pub fn build_engine_with(limits: EngineLimits) -> Engine {
     measure::register(&mut engine);
     facade::register(&mut engine);
     facade_analysis::register(&mut engine);
+    tracking::register(&mut engine);
+    tracking_sequence::register(&mut engine);
     kes::register(&mut engine);
     engine
 }

@@ -1,11 +1,35 @@
-//! Tracking: the tracking module owns cameras now, and the model-based tracker later.
+//! Tracking: cameras, the tracking puppet and its joints, synthetic multi-camera sequences
+//! with ground truth, and the analysis-by-synthesis body tracker.
 //!
 //! - [`camera`]: the pinhole camera with radial distortion used by every vision part, its
 //!   projection, and its JSON file format;
 //! - [`dlt`]: linear resection (normalised DLT) and the RQ split of a projection matrix;
 //! - [`calibration`]: camera calibration from 3D–2D correspondences (DLT, then
-//!   Levenberg–Marquardt refinement of intrinsics, distortion and pose).
+//!   Levenberg–Marquardt refinement of intrinsics, distortion and pose);
+//! - [`joints`]: the sixteen tracking joints on the MakeHuman skeleton, and the error measure;
+//! - [`puppet`], [`puppet_mesh`]: the tracking puppet (pose parameters with joint limits,
+//!   forward kinematics onto the MakeHuman skeleton) and its light mesh for rendering;
+//! - [`raster`]: the z-buffered vertex-colour rasterizer shared by sequences and tracker;
+//! - [`clothing`], [`sequence`], [`sequence_files`]: synthetic multi-camera sequences with
+//!   ground truth, and reading any sequence folder;
+//! - [`pyramid`], [`texture`], [`cost`], [`annealing`], [`tracker`]: the tracker;
+//! - [`bvh_export`], [`overlay`], [`swing_metrics`]: its outputs.
 
+pub mod annealing;
+pub mod bvh_export;
 pub mod calibration;
 pub mod camera;
+pub mod clothing;
+pub mod cost;
 pub mod dlt;
+pub mod joints;
+pub mod overlay;
+pub mod puppet;
+pub mod puppet_mesh;
+pub mod pyramid;
+pub mod raster;
+pub mod sequence;
+pub mod sequence_files;
+pub mod swing_metrics;
+pub mod texture;
+pub mod tracker;
