@@ -95,7 +95,8 @@ fn other_scripts_run() {
     for p in script_paths() {
         let name = p.file_stem().unwrap().to_str().unwrap().to_string();
         // the contact scripts run in tests/contact_scripts.rs, the garments in
-        // tests/garment_scripts.rs and buckle_square in tests/buckling.rs, with their checks
+        // tests/garment_scripts.rs, buckle_square in tests/buckling.rs and the tracking
+        // scripts in tests/tracking_track.rs, with their checks
         if [
             "hang",
             "drop",
@@ -110,6 +111,8 @@ fn other_scripts_run() {
             "paco",
             "buckle_square",
             "buckle_cylinder",
+            "make_sequence",
+            "track_body",
         ]
         .contains(&name.as_str())
         {

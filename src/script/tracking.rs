@@ -1,6 +1,141 @@
-//! Being written.
+//! Script bindings of the body tracker: tracking a sequence folder and writing its outputs.
 
-use rhai::Engine;
+use std::io::IsTerminal;
+use std::path::Path;
 
-/// Registers this module's script functions.
-pub fn register(_engine: &mut Engine) {}
+use indicatif::ProgressBar;
+use rhai::{Dynamic, Engine, Map, INT};
+
+use super::convert::{count, finite, rt_err, RResult};
+use super::register;
+use crate::body::Mannequin;
+use crate::tracking::sequence::data_dir;
+use crate::tracking::sequence_files::Sequence;
+use crate::tracking::track_outputs::{arm_joints, write_track_outputs, TrackOutputOptions};
+use crate::tracking::tracker::{track_sequence, TrackerOptions};
+
+fn options(m: &Map) -> RResult<(TrackerOptions, TrackOutputOptions, Option<String>)> {
+    let mut o = TrackerOptions::default();
+    let mut out = TrackOutputOptions::default();
+    let mut makehuman = None;
+    for (k, v) in m {
+        match k.as_str() {
+            "particles" => o.particles = count(v, "particles")?,
+            "layers" => {
+                let arr = v
+                    .read_lock::<rhai::Array>()
+                    .ok_or_else(|| rt_err("`layers` must be an array of pyramid levels"))?;
+                o.layers = arr
+                    .iter()
+                    .map(|d| count(d, "layers[]"))
+                    .collect::<RResult<Vec<_>>>()?;
+            }
+            "robust_sigma" => o.robust_sigma = finite(v, "robust_sigma")? as f32,
+            "mesh_cell" => o.mesh_cell = finite(v, "mesh_cell")?,
+            "lbs" => {
+                o.lbs = v
+                    .as_bool()
+                    .map_err(|_| rt_err("`lbs` must be true or false"))?
+            }
+            "background_frames" => o.background_frames = count(v, "background_frames")?,
+            "prediction" => o.prediction = finite(v, "prediction")?,
+            "seed" => o.seed = count(v, "seed")? as u64,
+            "frames" => o.frames = Some(count(v, "frames")?),
+            "overlay_every" => out.overlay_every = count(v, "overlay_every")?,
+            "makehuman" => makehuman = Some(v.to_string()),
+            other => {
+                return Err(rt_err(format!(
+                    "track_body: unknown option `{other}` (particles, layers, robust_sigma, \
+                     mesh_cell, lbs, background_frames, prediction, seed, frames, \
+                     overlay_every, makehuman)"
+                )))
+            }
+        }
+    }
+    Ok((o, out, makehuman))
+}
+
+fn track(seq_dir: &str, out: &str, m: &Map) -> RResult<Map> {
+    let (options, out_options, makehuman) = options(m)?;
+    let seq = Sequence::open(seq_dir).map_err(rt_err)?;
+    let mh = makehuman.map_or_else(|| data_dir().join("bodies/makehuman"), Into::into);
+    let mannequin = Mannequin::load_makehuman(&mh).map_err(rt_err)?;
+    let total = options.frames.map_or(seq.frames, |f| f.min(seq.frames));
+    let bar = std::io::stderr()
+        .is_terminal()
+        .then(|| ProgressBar::new(total as u64));
+    let result = track_sequence(&seq, &mannequin, &options, None, |done, _| {
+        if let Some(b) = &bar {
+            b.set_position(done as u64);
+        }
+    })
+    .map_err(rt_err)?;
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let files = write_track_outputs(&seq, &result, Path::new(out), &out_options).map_err(rt_err)?;
+    let mut r = Map::new();
+    let f = |x: Option<f64>| x.map_or(Dynamic::UNIT, Dynamic::from_float);
+    r.insert(
+        "frames".into(),
+        Dynamic::from_int(result.joints.len() as INT),
+    );
+    r.insert("mpjpe_mm".into(), f(result.mpjpe_mm()));
+    r.insert(
+        "max_frame_mm".into(),
+        f(result
+            .errors_mm
+            .as_ref()
+            .map(|e| e.iter().cloned().fold(0.0, f64::max))),
+    );
+    r.insert("arm_mm".into(), f(result.joints_error_mm(&arm_joints())));
+    r.insert(
+        "s_per_frame".into(),
+        Dynamic::from_float(result.seconds_per_frame()),
+    );
+    let n = result.frame_seconds.len().max(1) as f64;
+    let mut stages = Map::new();
+    for (k, v) in &result.stage_seconds {
+        stages.insert(k.as_str().into(), Dynamic::from_float(v / n));
+    }
+    stages.insert(
+        "images".into(),
+        Dynamic::from_float(result.io_seconds / result.joints.len().max(1) as f64),
+    );
+    r.insert("stage_seconds".into(), stages.into());
+    r.insert(
+        "start_seconds".into(),
+        Dynamic::from_float(result.start_seconds),
+    );
+    r.insert("files".into(), Dynamic::from_int(files.len() as INT));
+    Ok(r)
+}
+
+/// Registers the tracker's script functions.
+pub fn register(engine: &mut Engine) {
+    register!(
+        engine,
+        "track_body",
+        ["seq: String", "out: String", "Map"],
+        "Tracks the body in a sequence folder (the layout `make_sequence` writes: cameras,
+images per camera, `init_joints.csv` with an approximate first pose, and
+`ground_truth.csv` when known) by analysis-by-synthesis: the textured puppet rendered into
+every camera, its joint angles found frame by frame by annealing. Writes under `out`: the
+tracked motion (`tracked.bvh`, `tracked_joints.csv`), the broadcast pictures
+(`overlay/NNNN.png`), swing metrics (CSV and plots), `errors.csv` and `summary.json`.
+Returns #{frames, mpjpe_mm, max_frame_mm, arm_mm (elbows and wrists; () without ground
+truth), s_per_frame, stage_seconds (per frame), start_seconds, files}.",
+        |seq: &str, out: &str| track(seq, out, &Map::new())
+    );
+    register!(
+        engine,
+        "track_body",
+        ["seq: String", "out: String", "options: Map", "Map"],
+        "As `track_body(seq, out)` with options: `particles` per layer, `layers` (pyramid level
+of each annealing layer, coarse first, e.g. [1, 1, 1, 0, 0]), `robust_sigma` (grey levels),
+`mesh_cell` (metres), `lbs` (linear blend skinning instead of rigid), `background_frames`,
+`prediction` (velocity factor), `seed`, `frames` (track only the first frames),
+`overlay_every` (0: no pictures), `makehuman` (folder of the body model).",
+        |seq: &str, out: &str, m: Map| track(seq, out, &m)
+    );
+}

@@ -339,6 +339,23 @@ impl Camera {
         Some(self.project_camera_frame_unchecked(&pc))
     }
 
+    /// The same camera for an image pyramid level shrunk by `factor` (2 = half size): focal
+    /// lengths divided by `factor`, principal point `c' = (c + 0.5) / factor − 0.5` (pixel
+    /// centres stay consistent), width and height divided and rounded (at least 1); distortion
+    /// and pose unchanged.
+    pub fn scaled(&self, factor: f64) -> Camera {
+        let size = |n: u32| ((n as f64 / factor).round().max(1.0)) as u32;
+        Camera {
+            fx: self.fx / factor,
+            fy: self.fy / factor,
+            cx: (self.cx + 0.5) / factor - 0.5,
+            cy: (self.cy + 0.5) / factor - 0.5,
+            width: size(self.width),
+            height: size(self.height),
+            ..self.clone()
+        }
+    }
+
     /// Checks the invariants of the file format (finite values, positive focal lengths and image
     /// size, proper rotation); `source` names the camera in the error.
     pub fn validate_named(&self, source: &str) -> Result<(), CameraError> {
@@ -659,5 +676,29 @@ mod tests {
             msg.contains("x.json") && msg.contains("intrinsics.cx"),
             "{msg}"
         );
+    }
+
+    #[test]
+    fn scaled_camera_maps_pixel_areas_consistently() {
+        let c = cam();
+        let h = c.scaled(2.0);
+        assert_eq!((h.width, h.height), (160, 120));
+        assert_eq!((h.fx, h.fy), (200.0, 200.5));
+        assert_eq!((h.cx, h.cy), (80.75, 58.75));
+        assert_eq!(
+            (h.k1, h.k2, h.rotation, h.translation),
+            (c.k1, c.k2, c.rotation, c.translation)
+        );
+        let p = Vector3::new(0.3, -0.2, 2.5);
+        let (a, b) = (c.project(&p).expect("front"), h.project(&p).expect("front"));
+        // a full-resolution pixel u covers [u − 0.5, u + 0.5]; at half size that is (u + 0.5) / 2 − 0.5
+        for i in 0..2 {
+            assert!(
+                ((a[i] + 0.5) / 2.0 - 0.5 - b[i]).abs() < 1e-12,
+                "{a:?} {b:?}"
+            );
+        }
+        assert_eq!(c.scaled(1.0), c);
+        assert_eq!(c.scaled(3.0).width, 107);
     }
 }

@@ -1,1 +1,262 @@
-//! Being written.
+//! The image cost of a candidate pose: the puppet is posed, skinned, rendered with its
+//! learnt colours into every camera at one pyramid level, and compared with the images.
+//!
+//! Over the puppet's footprint in each camera the cost adds
+//! `ρ(I − R) − ρ(I − B)`: a robust colour difference between the image `I` and the rendered
+//! puppet `R`, minus the same difference between the image and the camera's background
+//! model `B`. Summed over the footprint this equals, up to a constant, the robust difference
+//! between the image and the puppet composited over the background, over the whole picture:
+//! the second term is the background-consistency term, which rewards covering pixels that
+//! do not look like the background and penalises covering pixels that do. Before the puppet
+//! has colours (first frame) only the background term is used (a silhouette fit).
+//! `ρ(d) = d² / (d² + σ²)` (Geman–McClure) on the RGB distance bounds the effect of
+//! occluders, noise and shading changes. Images are divided by their lighting gain first.
+//!
+//! Each thread evaluates candidates in its own [`CostWorkspace`]; nothing is allocated per
+//! evaluation.
+
+use image::RgbImage;
+
+use super::camera::Camera;
+use super::puppet::Puppet;
+use super::puppet_mesh::TrackingMesh;
+use super::pyramid::{build_pyramid, lighting_gain, Level};
+use super::raster::{draw_triangles, project_vertices, RasterTarget};
+use crate::body::skinning::Pose;
+use crate::geometry::Vec3;
+
+/// Geman–McClure robust function of a squared RGB distance.
+#[derive(Clone, Copy, Debug)]
+pub struct Robust {
+    /// Scale σ (grey levels): distances well above it count about the same.
+    pub sigma: f32,
+}
+
+impl Robust {
+    /// `d² / (d² + σ²)`.
+    #[inline]
+    pub fn rho(&self, d2: f32) -> f32 {
+        d2 / (d2 + self.sigma * self.sigma)
+    }
+
+    /// ρ of the distance between two colours.
+    #[inline]
+    pub fn rho_colours(&self, a: &[f32; 3], b: &[f32; 3]) -> f32 {
+        let d2 = (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2);
+        self.rho(d2)
+    }
+}
+
+/// One camera at one pyramid level: the scaled camera, the gain-normalised image and the
+/// per-pixel background term ρ(I − B).
+#[derive(Clone, Debug)]
+pub struct ViewLevel {
+    /// The camera at this level's resolution.
+    pub camera: Camera,
+    /// The current frame, divided by its lighting gain.
+    pub image: Level,
+    /// The background model at this level.
+    pub background: Level,
+    /// ρ(I − B) per pixel.
+    pub bg_cost: Vec<f32>,
+}
+
+/// Every camera at every pyramid level, for the current frame.
+#[derive(Clone, Debug)]
+pub struct FrameViews {
+    /// `views[camera][level]`.
+    pub views: Vec<Vec<ViewLevel>>,
+    /// Lighting gain of the current frame per camera.
+    pub gains: Vec<f32>,
+    robust: Robust,
+    scratch: Vec<f32>,
+}
+
+/// The camera scaled to pyramid level `level` (each level halves the size).
+pub fn camera_at_level(camera: &Camera, level: usize) -> Camera {
+    camera.scaled((1u32 << level) as f64)
+}
+
+impl FrameViews {
+    /// Views of `cameras` with their background models (level 0, one per camera), with
+    /// `levels` pyramid levels.
+    pub fn new(cameras: &[Camera], backgrounds: &[Level], levels: usize, robust: Robust) -> Self {
+        let views = cameras
+            .iter()
+            .zip(backgrounds)
+            .map(|(cam, bg)| {
+                let mut bgs = vec![bg.clone()];
+                for l in 1..levels.max(1) {
+                    let mut next = Level::default();
+                    bgs[l - 1].half_into(&mut next);
+                    bgs.push(next);
+                }
+                bgs.into_iter()
+                    .enumerate()
+                    .map(|(l, background)| ViewLevel {
+                        camera: camera_at_level(cam, l),
+                        image: Level::default(),
+                        bg_cost: vec![0.0; background.rgb.len()],
+                        background,
+                    })
+                    .collect()
+            })
+            .collect();
+        FrameViews {
+            views,
+            gains: vec![1.0; cameras.len()],
+            robust,
+            scratch: Vec::new(),
+        }
+    }
+
+    /// Number of pyramid levels.
+    pub fn levels(&self) -> usize {
+        self.views.first().map_or(0, Vec::len)
+    }
+
+    /// The robust function in use.
+    pub fn robust(&self) -> Robust {
+        self.robust
+    }
+
+    /// Loads a new frame (one image per camera, sizes already checked): pyramid, lighting
+    /// gain against the background, and the background term.
+    pub fn set_frame(&mut self, images: &[RgbImage]) {
+        let mut pyr = Vec::new();
+        for (c, img) in images.iter().enumerate() {
+            let levels = self.views[c].len();
+            build_pyramid(img, levels, &mut pyr);
+            let gain = lighting_gain(&pyr[0], &self.views[c][0].background, &mut self.scratch)
+                .clamp(0.2, 5.0);
+            self.gains[c] = gain;
+            for (l, level) in pyr.iter_mut().enumerate() {
+                level.scale(1.0 / gain);
+                let v = &mut self.views[c][l];
+                std::mem::swap(&mut v.image, level);
+                let r = self.robust;
+                for ((out, i), b) in v
+                    .bg_cost
+                    .iter_mut()
+                    .zip(&v.image.rgb)
+                    .zip(&v.background.rgb)
+                {
+                    *out = r.rho_colours(i, b);
+                }
+            }
+        }
+    }
+}
+
+/// What is rendered: the puppet, its light mesh and per-vertex colours.
+#[derive(Clone, Copy)]
+pub struct Appearance<'a> {
+    /// The puppet (pose parameters → bone transforms).
+    pub puppet: &'a Puppet,
+    /// The light mesh.
+    pub mesh: &'a TrackingMesh,
+    /// Colours per mesh vertex; `None` before they are learnt (silhouette cost only).
+    pub colours: Option<&'a [[f32; 3]]>,
+    /// Linear blend skinning instead of rigid (each vertex on its dominant bone).
+    pub lbs: bool,
+}
+
+/// Per-thread buffers of the cost evaluation.
+#[derive(Debug)]
+pub struct CostWorkspace {
+    /// Bone transforms of the candidate.
+    pub pose: Pose,
+    /// Skinned mesh vertices.
+    pub skinned: Vec<Vec3>,
+    projected: Vec<[f32; 3]>,
+    grey: Vec<[f32; 3]>,
+    /// `targets[camera][level]`.
+    targets: Vec<Vec<RasterTarget>>,
+}
+
+impl CostWorkspace {
+    /// Buffers for `views` and a puppet whose mannequin has `bones` bones.
+    pub fn new(views: &FrameViews, bones: usize, vertices: usize) -> Self {
+        CostWorkspace {
+            pose: Pose::identity(bones),
+            skinned: vec![Vec3::zeros(); vertices],
+            projected: Vec::with_capacity(vertices),
+            grey: vec![[128.0; 3]; vertices],
+            targets: views
+                .views
+                .iter()
+                .map(|v| {
+                    v.iter()
+                        .map(|l| RasterTarget::new(l.image_width(), l.image_height()))
+                        .collect()
+                })
+                .collect(),
+        }
+    }
+
+    /// Poses and skins the mesh for `params`.
+    pub fn pose_mesh(&mut self, app: &Appearance, params: &[f64]) {
+        app.puppet.pose_into(params, &mut self.pose);
+        if app.lbs {
+            app.mesh.skin_lbs_into(&self.pose, &mut self.skinned);
+        } else {
+            app.mesh.skin_rigid_into(&self.pose, &mut self.skinned);
+        }
+    }
+
+    /// The rendered target of camera `c` at `level` after the last [`pose_cost`].
+    pub fn target(&self, c: usize, level: usize) -> &RasterTarget {
+        &self.targets[c][level]
+    }
+}
+
+impl ViewLevel {
+    fn image_width(&self) -> usize {
+        self.camera.width as usize
+    }
+    fn image_height(&self) -> usize {
+        self.camera.height as usize
+    }
+}
+
+/// The cost of pose `params` at pyramid `level` (lower is better). Per pixel terms are
+/// summed over cameras and scaled by `4^level / 1000`, so levels give comparable numbers.
+pub fn pose_cost(
+    app: &Appearance,
+    views: &FrameViews,
+    level: usize,
+    params: &[f64],
+    ws: &mut CostWorkspace,
+) -> f64 {
+    ws.pose_mesh(app, params);
+    let robust = views.robust;
+    let mut total = 0.0f64;
+    for (c, view) in views.views.iter().enumerate() {
+        let vl = &view[level];
+        project_vertices(&vl.camera, &ws.skinned, &mut ws.projected);
+        let target = &mut ws.targets[c][level];
+        target.clear();
+        let colours = app.colours.unwrap_or(&ws.grey);
+        draw_triangles(target, &ws.projected, colours, &app.mesh.triangles);
+        let Some((x0, y0, x1, y1)) = target.touched() else {
+            continue;
+        };
+        let w = target.width;
+        let mut sum = 0.0f32;
+        for y in y0..y1 {
+            let row = y * w;
+            for i in row + x0..row + x1 {
+                if target.depth[i] < f32::INFINITY {
+                    let bg = vl.bg_cost[i];
+                    sum += if app.colours.is_some() {
+                        robust.rho_colours(&vl.image.rgb[i], &target.rgb[i]) - bg
+                    } else {
+                        -bg
+                    };
+                }
+            }
+        }
+        total += sum as f64;
+    }
+    total * (1u64 << (2 * level)) as f64 / 1000.0
+}

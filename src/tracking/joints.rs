@@ -89,9 +89,9 @@ impl JointSet {
         let mut bones = [0; JOINT_COUNT];
         let mut rest = [Vec3::zeros(); JOINT_COUNT];
         for (k, t) in TRACKING_JOINTS.iter().enumerate() {
-            let b = sk
-                .bone_index(t.bone)
-                .ok_or_else(|| format!("the skeleton has no bone `{}` (joint {})", t.bone, t.name))?;
+            let b = sk.bone_index(t.bone).ok_or_else(|| {
+                format!("the skeleton has no bone `{}` (joint {})", t.bone, t.name)
+            })?;
             bones[k] = b;
             let bone = &sk.bones()[b];
             rest[k] = match t.end {

@@ -13,7 +13,7 @@
 //! - [`clothing`], [`sequence`], [`sequence_files`]: synthetic multi-camera sequences with
 //!   ground truth, and reading any sequence folder;
 //! - [`pyramid`], [`texture`], [`cost`], [`annealing`], [`tracker`]: the tracker;
-//! - [`bvh_export`], [`overlay`], [`swing_metrics`]: its outputs.
+//! - [`bvh_export`], [`overlay`], [`swing_metrics`], [`track_outputs`]: its outputs.
 
 pub mod annealing;
 pub mod bvh_export;
@@ -32,4 +32,5 @@ pub mod sequence;
 pub mod sequence_files;
 pub mod swing_metrics;
 pub mod texture;
+pub mod track_outputs;
 pub mod tracker;

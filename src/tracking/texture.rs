@@ -1,1 +1,168 @@
-//! Being written.
+//! The puppet's texture, learnt from the images by back-projection: every vertex of the
+//! light mesh takes the colour the cameras see at its projection, averaged over the cameras
+//! where it is visible (z-buffer test) and weighted by how squarely each camera sees it
+//! (cos² of the angle between the surface normal and the line of sight). Vertices no camera
+//! sees take the mean of their mesh neighbours (repeated diffusion), so the puppet has no
+//! holes where it was hidden on the first frame.
+
+use super::camera::Camera;
+use super::puppet_mesh::TrackingMesh;
+use super::pyramid::Level;
+use super::raster::{draw_triangles, project_vertices, RasterTarget};
+use crate::geometry::Vec3;
+
+/// Depth tolerance of the visibility test, metres.
+const VISIBILITY_TOLERANCE: f32 = 0.03;
+/// Views seen more obliquely than this (cosine) do not contribute.
+const MIN_COSINE: f64 = 0.2;
+
+/// Area-weighted vertex normals of a posed mesh (outward for outward-wound triangles).
+pub fn vertex_normals(positions: &[Vec3], triangles: &[[u32; 3]], out: &mut Vec<Vec3>) {
+    out.clear();
+    out.resize(positions.len(), Vec3::zeros());
+    for t in triangles {
+        let [a, b, c] = t.map(|i| i as usize);
+        let n = (positions[b] - positions[a]).cross(&(positions[c] - positions[a]));
+        out[a] += n;
+        out[b] += n;
+        out[c] += n;
+    }
+    for n in out.iter_mut() {
+        *n = n.try_normalize(1e-20).unwrap_or_else(Vec3::zeros);
+    }
+}
+
+/// Learns one colour per vertex of `mesh`, posed at `skinned`, from the views
+/// (camera and image at the same resolution). Returns the colours and how many vertices at
+/// least one camera saw.
+pub fn learn_colours(
+    mesh: &TrackingMesh,
+    skinned: &[Vec3],
+    views: &[(&Camera, &Level)],
+) -> (Vec<[f32; 3]>, usize) {
+    let n = skinned.len();
+    let mut normals = Vec::new();
+    vertex_normals(skinned, &mesh.triangles, &mut normals);
+    let mut sum = vec![[0.0f64; 3]; n];
+    let mut weight = vec![0.0f64; n];
+    let mut projected = Vec::with_capacity(n);
+    let grey = vec![[0.0f32; 3]; n];
+    for (camera, image) in views {
+        project_vertices(camera, skinned, &mut projected);
+        let mut target = RasterTarget::new(image.width, image.height);
+        draw_triangles(&mut target, &projected, &grey, &mesh.triangles);
+        let centre = camera.center();
+        for v in 0..n {
+            let [x, y, z] = projected[v];
+            if !(x >= 0.0 && y >= 0.0) || z <= 0.0 {
+                continue;
+            }
+            let (px, py) = (x as usize, y as usize);
+            if px >= image.width || py >= image.height {
+                continue;
+            }
+            // nearest depth around the projection (the vertex lies on triangle edges)
+            let mut nearest = f32::INFINITY;
+            for dy in -1i64..=1 {
+                for dx in -1i64..=1 {
+                    let (qx, qy) = (px as i64 + dx, py as i64 + dy);
+                    if qx >= 0
+                        && qy >= 0
+                        && (qx as usize) < image.width
+                        && (qy as usize) < image.height
+                    {
+                        nearest =
+                            nearest.min(target.depth[qy as usize * image.width + qx as usize]);
+                    }
+                }
+            }
+            if z > nearest + VISIBILITY_TOLERANCE {
+                continue;
+            }
+            let to_cam = Vec3::new(centre.x, centre.y, centre.z) - skinned[v];
+            let cos = normals[v].dot(&to_cam) / to_cam.norm().max(1e-12);
+            if cos < MIN_COSINE {
+                continue;
+            }
+            if let Some(c) = image.sample(x as f64, y as f64) {
+                let w = cos * cos;
+                for k in 0..3 {
+                    sum[v][k] += w * c[k] as f64;
+                }
+                weight[v] += w;
+            }
+        }
+    }
+    let seen = weight.iter().filter(|&&w| w > 0.0).count();
+    let mut colours: Vec<[f32; 3]> = (0..n)
+        .map(|v| {
+            if weight[v] > 0.0 {
+                sum[v].map(|s| (s / weight[v]) as f32)
+            } else {
+                [0.0; 3]
+            }
+        })
+        .collect();
+    fill_unseen(mesh, &weight, &mut colours);
+    (colours, seen)
+}
+
+/// Gives unseen vertices (weight 0) the mean colour of their known neighbours, spreading
+/// inward until every vertex connected to a seen one has a colour.
+fn fill_unseen(mesh: &TrackingMesh, weight: &[f64], colours: &mut [[f32; 3]]) {
+    let n = colours.len();
+    let mut known: Vec<bool> = weight.iter().map(|&w| w > 0.0).collect();
+    if known.iter().all(|&k| k) || !known.iter().any(|&k| k) {
+        return;
+    }
+    let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for t in &mesh.triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k] as usize, t[(k + 1) % 3]);
+            neighbours[a].push(b);
+            neighbours[b as usize].push(t[k]);
+        }
+    }
+    loop {
+        let mut changed = Vec::new();
+        for v in 0..n {
+            if known[v] {
+                continue;
+            }
+            let (mut s, mut c) = ([0.0f32; 3], 0);
+            for &u in &neighbours[v] {
+                if known[u as usize] {
+                    for k in 0..3 {
+                        s[k] += colours[u as usize][k];
+                    }
+                    c += 1;
+                }
+            }
+            if c > 0 {
+                changed.push((v, s.map(|x| x / c as f32)));
+            }
+        }
+        if changed.is_empty() {
+            break;
+        }
+        for (v, col) in changed {
+            colours[v] = col;
+            known[v] = true;
+        }
+    }
+    // parts not connected to any seen vertex: the mean of the seen colours
+    let (mut s, mut c) = ([0.0f64; 3], 0.0);
+    for (v, col) in colours.iter().enumerate() {
+        if weight[v] > 0.0 {
+            for k in 0..3 {
+                s[k] += col[k] as f64;
+            }
+            c += 1.0;
+        }
+    }
+    for v in 0..n {
+        if !known[v] {
+            colours[v] = s.map(|x| (x / c) as f32);
+        }
+    }
+}

@@ -1,1 +1,503 @@
-//! Being written.
+//! The body tracker, by analysis-by-synthesis (seed report §3.1, §5.1): the textured puppet is
+//! rendered into every camera and its pose is searched so the renders match the images.
+//!
+//! * **Start**: the puppet is pre-positioned on frame 0 from approximate 3D joints (the
+//!   sequence's `init_joints.csv`, or given) by a least-squares fit of its joint angles, then
+//!   refined by annealing on the silhouette (background term only). Its colours are learnt by
+//!   back-projection from all cameras, the pose is annealed again with colours, and the
+//!   colours are learnt once more.
+//! * **Each frame**: prediction from the two previous poses (damped constant velocity), then
+//!   annealing in stages down the hierarchy: root and chest together, then the head, then each
+//!   arm and each leg. Each stage moves only its own parameters; its layers go from a coarse
+//!   pyramid level to the full image. Candidates of a layer are evaluated in parallel.
+//! * The background model of each camera is its clean plate (the empty scene, shot before),
+//!   or without one the per-pixel median of frames spread over the sequence (which keeps the
+//!   parts of a person who hardly moves); each frame's lighting gain is measured against it.
+
+use std::sync::Mutex;
+use std::time::Instant;
+
+use image::RgbImage;
+
+use super::annealing::{anneal, AnnealScratch, AnnealSettings};
+use super::cost::{pose_cost, Appearance, CostWorkspace, FrameViews, Robust};
+use super::joints::{mpjpe, JOINT_COUNT};
+use super::puppet::{PartGroup, Puppet};
+use super::puppet_mesh::TrackingMesh;
+use super::pyramid::{median_background, Level};
+use super::sequence_files::{Sequence, SequenceError};
+use super::texture::learn_colours;
+use crate::body::Mannequin;
+use crate::geometry::{SplitMix64, Vec3};
+
+/// Errors of the tracker.
+#[derive(Debug, thiserror::Error)]
+pub enum TrackError {
+    /// Reading the sequence failed.
+    #[error(transparent)]
+    Sequence(#[from] SequenceError),
+    /// The puppet could not be built.
+    #[error("puppet: {0}")]
+    Puppet(String),
+    /// A setting or input is unusable.
+    #[error("{0}")]
+    Invalid(String),
+}
+
+/// Tracker settings.
+#[derive(Clone, Debug)]
+pub struct TrackerOptions {
+    /// Particles per annealing layer.
+    pub particles: usize,
+    /// Pyramid level of each annealing layer of a stage (coarse first).
+    pub layers: Vec<usize>,
+    /// Robust scale σ of the colour difference (grey levels).
+    pub robust_sigma: f32,
+    /// Cell size of the light mesh (metres).
+    pub mesh_cell: f64,
+    /// Linear blend skinning instead of rigid.
+    pub lbs: bool,
+    /// Frames sampled for the background median.
+    pub background_frames: usize,
+    /// Prediction factor on the last velocity (0 = constant position).
+    pub prediction: f64,
+    /// Seed of the annealing moves.
+    pub seed: u64,
+    /// Track at most this many frames (from frame 0).
+    pub frames: Option<usize>,
+}
+
+impl Default for TrackerOptions {
+    fn default() -> Self {
+        TrackerOptions {
+            particles: 32,
+            layers: vec![1, 1, 1, 0, 0],
+            robust_sigma: 40.0,
+            mesh_cell: 0.03,
+            lbs: false,
+            background_frames: 25,
+            prediction: 0.7,
+            seed: 1,
+            frames: None,
+        }
+    }
+}
+
+/// Tracked motion and its diagnostics.
+#[derive(Clone, Debug, Default)]
+pub struct TrackResult {
+    /// Tracked joints per frame (metres, world).
+    pub joints: Vec<[Vec3; JOINT_COUNT]>,
+    /// Puppet parameters per frame.
+    pub params: Vec<Vec<f64>>,
+    /// Final cost per frame.
+    pub costs: Vec<f64>,
+    /// Wall time per frame (seconds).
+    pub frame_seconds: Vec<f64>,
+    /// Total wall time per stage (seconds), in stage order.
+    pub stage_seconds: Vec<(String, f64)>,
+    /// Seconds spent reading images and building pyramids, in total.
+    pub io_seconds: f64,
+    /// Seconds of the start (background, pre-positioning, texture).
+    pub start_seconds: f64,
+    /// Cost evaluations in total.
+    pub evaluations: usize,
+    /// Per-frame mean joint error against the ground truth (mm), when present.
+    pub errors_mm: Option<Vec<f64>>,
+    /// Per-frame, per-joint errors (mm), when the ground truth is present.
+    pub joint_errors_mm: Option<Vec<[f64; JOINT_COUNT]>>,
+}
+
+impl TrackResult {
+    /// Mean per-joint position error over all frames (mm).
+    pub fn mpjpe_mm(&self) -> Option<f64> {
+        let e = self.errors_mm.as_ref()?;
+        (!e.is_empty()).then(|| e.iter().sum::<f64>() / e.len() as f64)
+    }
+
+    /// Mean error of some joints over all frames (mm).
+    pub fn joints_error_mm(&self, joints: &[usize]) -> Option<f64> {
+        let e = self.joint_errors_mm.as_ref()?;
+        let n = (e.len() * joints.len()) as f64;
+        (n > 0.0).then(|| {
+            e.iter()
+                .map(|f| joints.iter().map(|&j| f[j]).sum::<f64>())
+                .sum::<f64>()
+                / n
+        })
+    }
+
+    /// Mean wall time per tracked frame (seconds), start excluded.
+    pub fn seconds_per_frame(&self) -> f64 {
+        if self.frame_seconds.is_empty() {
+            0.0
+        } else {
+            self.frame_seconds.iter().sum::<f64>() / self.frame_seconds.len() as f64
+        }
+    }
+}
+
+/// One stage of the hierarchical search: a name and the parameter groups it moves.
+struct Stage {
+    name: &'static str,
+    groups: &'static [PartGroup],
+}
+
+const STAGES: &[Stage] = &[
+    Stage {
+        name: "torso",
+        groups: &[PartGroup::Root, PartGroup::Torso],
+    },
+    Stage {
+        name: "head",
+        groups: &[PartGroup::Head],
+    },
+    Stage {
+        name: "left arm",
+        groups: &[PartGroup::LeftArm],
+    },
+    Stage {
+        name: "right arm",
+        groups: &[PartGroup::RightArm],
+    },
+    Stage {
+        name: "left leg",
+        groups: &[PartGroup::LeftLeg],
+    },
+    Stage {
+        name: "right leg",
+        groups: &[PartGroup::RightLeg],
+    },
+];
+
+/// Initial move spread of parameter `k` (metres for the root translation, radians else).
+fn move_sigma(k: usize, group: PartGroup) -> f64 {
+    match group {
+        PartGroup::Root if k < 3 => 0.03,
+        PartGroup::Root | PartGroup::Torso => 0.08,
+        PartGroup::Head => 0.15,
+        PartGroup::LeftArm | PartGroup::RightArm => 0.25,
+        PartGroup::LeftLeg | PartGroup::RightLeg => 0.2,
+        _ => 0.2,
+    }
+}
+
+/// The tracker's state between frames.
+pub struct Tracker {
+    puppet: Puppet,
+    mesh: TrackingMesh,
+    colours: Option<Vec<[f32; 3]>>,
+    views: FrameViews,
+    workspaces: Vec<Mutex<CostWorkspace>>,
+    options: TrackerOptions,
+    rng: SplitMix64,
+    history: Vec<Vec<f64>>,
+    scratch: AnnealScratch,
+    stage_seconds: Vec<f64>,
+    evaluations: usize,
+}
+
+impl Tracker {
+    /// A tracker for `cameras` with their background models (full resolution).
+    pub fn new(
+        mannequin: &Mannequin,
+        cameras: &[super::camera::Camera],
+        backgrounds: &[Level],
+        options: TrackerOptions,
+    ) -> Result<Tracker, TrackError> {
+        if options.particles < 2 || options.layers.is_empty() {
+            return Err(TrackError::Invalid(format!(
+                "tracker: need at least 2 particles and one layer (got {} and {})",
+                options.particles,
+                options.layers.len()
+            )));
+        }
+        if !(options.robust_sigma > 0.0) || !(options.mesh_cell > 0.0) {
+            return Err(TrackError::Invalid(
+                "tracker: robust_sigma and mesh_cell must be positive".into(),
+            ));
+        }
+        let puppet = Puppet::new(mannequin).map_err(|e| TrackError::Puppet(e.to_string()))?;
+        let mesh = TrackingMesh::build(mannequin, &puppet, options.mesh_cell);
+        let levels = options.layers.iter().max().copied().unwrap_or(0) + 1;
+        let views = FrameViews::new(
+            cameras,
+            backgrounds,
+            levels,
+            Robust {
+                sigma: options.robust_sigma,
+            },
+        );
+        let bones = mannequin.skeleton().len();
+        let threads = rayon::current_num_threads() + 1;
+        let workspaces = (0..threads)
+            .map(|_| Mutex::new(CostWorkspace::new(&views, bones, mesh.rest.len())))
+            .collect();
+        Ok(Tracker {
+            rng: SplitMix64::new(options.seed),
+            puppet,
+            mesh,
+            colours: None,
+            views,
+            workspaces,
+            options,
+            history: Vec::new(),
+            scratch: AnnealScratch::default(),
+            stage_seconds: vec![0.0; STAGES.len()],
+            evaluations: 0,
+        })
+    }
+
+    /// The puppet.
+    pub fn puppet(&self) -> &Puppet {
+        &self.puppet
+    }
+
+    /// Runs the stages on the current frame from `start` (move spreads scaled by
+    /// `sigma_scale`); returns the pose and its cost.
+    pub fn search(&mut self, start: &[f64], sigma_scale: f64) -> (Vec<f64>, f64) {
+        let settings = AnnealSettings {
+            particles: self.options.particles,
+            levels: self.options.layers.clone(),
+            ..Default::default()
+        };
+        let mut params = start.to_vec();
+        let mut cost = f64::INFINITY;
+        let infos = self.puppet.params().to_vec();
+        for (s, stage) in STAGES.iter().enumerate() {
+            let t0 = Instant::now();
+            let dofs: Vec<usize> = (0..infos.len())
+                .filter(|&k| stage.groups.contains(&infos[k].group))
+                .collect();
+            if dofs.is_empty() {
+                continue;
+            }
+            let sigma: Vec<f64> = dofs
+                .iter()
+                .map(|&k| sigma_scale * move_sigma(k, infos[k].group))
+                .collect();
+            let app = Appearance {
+                puppet: &self.puppet,
+                mesh: &self.mesh,
+                colours: self.colours.as_deref(),
+                lbs: self.options.lbs,
+            };
+            let views = &self.views;
+            let workspaces = &self.workspaces;
+            let puppet = &self.puppet;
+            let r = anneal(
+                &params,
+                &dofs,
+                &sigma,
+                &settings,
+                &mut self.rng,
+                |p| puppet.clamp(p),
+                |p, level| {
+                    let slot = rayon::current_thread_index().unwrap_or(workspaces.len() - 1);
+                    let mut ws = match workspaces[slot.min(workspaces.len() - 1)].lock() {
+                        Ok(g) => g,
+                        Err(poisoned) => poisoned.into_inner(),
+                    };
+                    pose_cost(&app, views, level, p, &mut ws)
+                },
+                &mut self.scratch,
+            );
+            self.evaluations += r.evaluations;
+            params = r.params;
+            cost = r.cost;
+            self.stage_seconds[s] += t0.elapsed().as_secs_f64();
+        }
+        (params, cost)
+    }
+
+    /// Learns the colours from the current frame at pose `params` (full resolution).
+    fn learn(&mut self, params: &[f64]) -> usize {
+        let app = Appearance {
+            puppet: &self.puppet,
+            mesh: &self.mesh,
+            colours: None,
+            lbs: self.options.lbs,
+        };
+        let mut ws = match self.workspaces[0].lock() {
+            Ok(g) => g,
+            Err(p) => p.into_inner(),
+        };
+        ws.pose_mesh(&app, params);
+        let views: Vec<_> = self
+            .views
+            .views
+            .iter()
+            .map(|v| (&v[0].camera, &v[0].image))
+            .collect();
+        let (colours, seen) = learn_colours(&self.mesh, &ws.skinned, &views);
+        drop(ws);
+        self.colours = Some(colours);
+        seen
+    }
+
+    /// Frame 0: pre-positioning from approximate joints, silhouette refinement, texture.
+    pub fn start(
+        &mut self,
+        images: &[RgbImage],
+        approx: &[Vec3; JOINT_COUNT],
+    ) -> Result<Vec<f64>, TrackError> {
+        if approx.iter().any(|p| !p.iter().all(|v| v.is_finite())) {
+            return Err(TrackError::Invalid(
+                "approximate first-frame joints are not finite".into(),
+            ));
+        }
+        self.views.set_frame(images);
+        let rest = self.puppet.rest_params();
+        let fitted = self.puppet.fit_to_joints(approx, &rest);
+        self.colours = None;
+        let (silhouette, _) = self.search(&fitted, 0.3);
+        self.learn(&silhouette);
+        let (refined, _) = self.search(&silhouette, 0.3);
+        self.learn(&refined);
+        self.history = vec![refined.clone()];
+        Ok(refined)
+    }
+
+    /// Frame 0 from a known pose (no search): learns the colours there.
+    pub fn start_at(&mut self, images: &[RgbImage], params: &[f64]) -> Vec<f64> {
+        self.views.set_frame(images);
+        let mut p = params.to_vec();
+        self.puppet.clamp(&mut p);
+        self.learn(&p);
+        self.history = vec![p.clone()];
+        p
+    }
+
+    /// Loads the images of the next frame (pyramids, lighting gain) without searching.
+    pub fn set_frame(&mut self, images: &[RgbImage]) {
+        self.views.set_frame(images);
+    }
+
+    /// Tracks one frame (after [`start`](Self::start)); returns the pose and its cost.
+    pub fn track(&mut self, images: &[RgbImage]) -> (Vec<f64>, f64) {
+        self.views.set_frame(images);
+        let n = self.history.len();
+        let mut predicted = self.history[n - 1].clone();
+        if n >= 2 {
+            let f = self.options.prediction;
+            for (k, p) in predicted.iter_mut().enumerate() {
+                *p += f * (self.history[n - 1][k] - self.history[n - 2][k]);
+            }
+            self.puppet.clamp(&mut predicted);
+        }
+        let (params, cost) = self.search(&predicted, 1.0);
+        self.history.push(params.clone());
+        if self.history.len() > 2 {
+            self.history.remove(0);
+        }
+        (params, cost)
+    }
+
+    /// The tracking joints of pose `params`.
+    pub fn joints(&self, params: &[f64]) -> [Vec3; JOINT_COUNT] {
+        let mut ws = match self.workspaces[0].lock() {
+            Ok(g) => g,
+            Err(p) => p.into_inner(),
+        };
+        self.puppet.pose_into(params, &mut ws.pose);
+        self.puppet.joints(&ws.pose)
+    }
+}
+
+/// Background model of every camera: the median of up to `count` frames spread evenly
+/// over the sequence.
+pub fn sequence_backgrounds(
+    seq: &Sequence,
+    frames: usize,
+    count: usize,
+) -> Result<Vec<Level>, TrackError> {
+    let picks: Vec<usize> = if frames <= count.max(1) {
+        (0..frames).collect()
+    } else {
+        (0..count)
+            .map(|i| i * (frames - 1) / (count - 1).max(1))
+            .collect()
+    };
+    let mut per_camera: Vec<Vec<RgbImage>> = vec![Vec::new(); seq.cameras.len()];
+    for &k in &picks {
+        for (c, img) in seq.frame_images(k)?.into_iter().enumerate() {
+            per_camera[c].push(img);
+        }
+    }
+    Ok(per_camera
+        .iter()
+        .map(|imgs| median_background(&imgs.iter().collect::<Vec<_>>()))
+        .collect())
+}
+
+/// Tracks a whole sequence (or its first `options.frames` frames). `progress(done, total)`
+/// is called after each frame.
+pub fn track_sequence(
+    seq: &Sequence,
+    mannequin: &Mannequin,
+    options: &TrackerOptions,
+    approx: Option<&[Vec3; JOINT_COUNT]>,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<TrackResult, TrackError> {
+    let t_start = Instant::now();
+    let frames = options.frames.map_or(seq.frames, |f| f.min(seq.frames));
+    if frames == 0 {
+        return Err(TrackError::Invalid(format!(
+            "{}: no frames to track",
+            seq.dir.display()
+        )));
+    }
+    let approx = approx.or(seq.init_joints.as_ref()).ok_or_else(|| {
+        TrackError::Invalid(format!(
+            "{}: no init_joints.csv, and no approximate first pose given",
+            seq.dir.display()
+        ))
+    })?;
+    let backgrounds = match seq.background_plates()? {
+        Some(plates) => plates.iter().map(Level::from_image).collect(),
+        None => sequence_backgrounds(seq, seq.frames, options.background_frames)?,
+    };
+    let mut tracker = Tracker::new(mannequin, &seq.cameras, &backgrounds, options.clone())?;
+    let mut result = TrackResult::default();
+    let t_io = Instant::now();
+    let images = seq.frame_images(0)?;
+    result.io_seconds += t_io.elapsed().as_secs_f64();
+    let first = tracker.start(&images, approx)?;
+    tracker.stage_seconds.iter_mut().for_each(|s| *s = 0.0);
+    tracker.evaluations = 0;
+    result.start_seconds = t_start.elapsed().as_secs_f64();
+    result.joints.push(tracker.joints(&first));
+    result.params.push(first);
+    result.costs.push(0.0);
+    progress(1, frames);
+    for k in 1..frames {
+        let t0 = Instant::now();
+        let images = seq.frame_images(k)?;
+        result.io_seconds += t0.elapsed().as_secs_f64();
+        let (params, cost) = tracker.track(&images);
+        result.joints.push(tracker.joints(&params));
+        result.params.push(params);
+        result.costs.push(cost);
+        result.frame_seconds.push(t0.elapsed().as_secs_f64());
+        progress(k + 1, frames);
+    }
+    result.stage_seconds = STAGES
+        .iter()
+        .zip(&tracker.stage_seconds)
+        .map(|(s, &t)| (s.name.to_string(), t))
+        .collect();
+    result.evaluations = tracker.evaluations;
+    if let Some(gt) = &seq.ground_truth {
+        let mut per_frame = Vec::new();
+        let mut per_joint = Vec::new();
+        for (k, j) in result.joints.iter().enumerate() {
+            if let Some(t) = gt.get(k) {
+                per_frame.push(1000.0 * mpjpe(j, t));
+                per_joint.push(std::array::from_fn(|i| 1000.0 * (j[i] - t[i]).norm()));
+            }
+        }
+        result.errors_mm = Some(per_frame);
+        result.joint_errors_mm = Some(per_joint);
+    }
+    Ok(result)
+}

@@ -1,0 +1,159 @@
+//! Diagnostics of the tracker's cost on a sequence made from a BVH clip: the cost at the
+//! true pose against perturbed poses, and annealing started from the true pose.
+//! `cargo run --release --example track_diag -- SEQ_DIR CLIP.bvh [background: median|plate]`
+
+use std::path::Path;
+
+use emilion::body::retarget::{Animation, RetargetOptions};
+use emilion::body::{Mannequin, Motion};
+use emilion::tracking::cost::{pose_cost, Appearance, CostWorkspace, FrameViews, Robust};
+use emilion::tracking::joints::mpjpe;
+use emilion::tracking::puppet::Puppet;
+use emilion::tracking::puppet_mesh::TrackingMesh;
+use emilion::tracking::sequence_files::Sequence;
+use emilion::tracking::texture::learn_colours;
+use emilion::tracking::tracker::sequence_backgrounds;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let seq = Sequence::open(&args[1])?;
+    let mannequin = Mannequin::load_makehuman(Path::new("../shared/data/bodies/makehuman"))?;
+    let motion = Motion::load_bvh(Path::new(&args[2]))?;
+    let anim = Animation::new(mannequin.clone(), motion, RetargetOptions::default())?;
+    let puppet = Puppet::new(&mannequin)?;
+    let mesh = TrackingMesh::build(&mannequin, &puppet, 0.03);
+    println!(
+        "mesh: {} vertices, {} triangles",
+        mesh.rest.len(),
+        mesh.triangles.len()
+    );
+    let backgrounds = backgrounds_for(&seq, &args)?;
+    let mut views = FrameViews::new(&seq.cameras, &backgrounds, 3, Robust { sigma: 40.0 });
+    let mut ws = CostWorkspace::new(&views, mannequin.skeleton().len(), mesh.rest.len());
+    let gt_params: Vec<Vec<f64>> = (0..seq.frames)
+        .map(|k| puppet.params_from_pose(&anim.pose_at(k as f64 / seq.fps)))
+        .collect();
+    // representation check
+    let gt = seq.ground_truth.as_ref().ok_or("no ground truth")?;
+    let mut worst: f64 = 0.0;
+    for (k, p) in gt_params.iter().enumerate() {
+        puppet.pose_into(p, &mut ws.pose);
+        worst = worst.max(mpjpe(&puppet.joints(&ws.pose), &gt[k]));
+    }
+    println!(
+        "puppet vs ground truth joints: worst frame {:.3} mm",
+        worst * 1000.0
+    );
+    views.set_frame(&seq.frame_images(0)?);
+    let app0 = Appearance {
+        puppet: &puppet,
+        mesh: &mesh,
+        colours: None,
+        lbs: false,
+    };
+    ws.pose_mesh(&app0, &gt_params[0]);
+    let vv: Vec<_> = views
+        .views
+        .iter()
+        .map(|v| (&v[0].camera, &v[0].image))
+        .collect();
+    let (colours, seen) = learn_colours(&mesh, &ws.skinned, &vv);
+    println!(
+        "texture: {seen} of {} vertices seen; gains {:?}",
+        mesh.rest.len(),
+        views.gains
+    );
+    let app = Appearance {
+        colours: Some(&colours),
+        ..app0
+    };
+    for &k in &[0usize, 5, 10, 15] {
+        if k >= seq.frames {
+            break;
+        }
+        views.set_frame(&seq.frame_images(k)?);
+        for level in 0..3 {
+            let c0 = pose_cost(&app, &views, level, &gt_params[k], &mut ws);
+            let s0 = pose_cost(&app0, &views, level, &gt_params[k], &mut ws);
+            let mut line = format!(
+                "frame {k} level {level}: cost {c0:.3} (silhouette {s0:.3}); +0.15 rad / 3 cm on"
+            );
+            for (i, info) in puppet.params().iter().enumerate() {
+                if i % 3 != 0 && i >= 6 {
+                    continue;
+                }
+                let mut p = gt_params[k].clone();
+                p[i] += if i < 3 { 0.03 } else { 0.15 };
+                let c = pose_cost(&app, &views, level, &p, &mut ws);
+                line += &format!(" {}:{:+.3}", info.name, c - c0);
+            }
+            println!("{line}");
+        }
+    }
+    track_from_truth(&seq, &mannequin, &gt_params, 20, Default::default())?;
+    Ok(())
+}
+
+/// Tracks `frames` frames from the true first pose; prints per-frame errors (mm).
+pub fn track_from_truth(
+    seq: &Sequence,
+    mannequin: &Mannequin,
+    gt_params: &[Vec<f64>],
+    frames: usize,
+    options: emilion::tracking::tracker::TrackerOptions,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let backgrounds = backgrounds_for(seq, &std::env::args().collect::<Vec<_>>())?;
+    let mut t =
+        emilion::tracking::tracker::Tracker::new(mannequin, &seq.cameras, &backgrounds, options)?;
+    let gt = seq.ground_truth.as_ref().ok_or("no ground truth")?;
+    t.start_at(&seq.frame_images(0)?, &gt_params[0]);
+    for k in [1usize, 5, 10] {
+        t.set_frame(&seq.frame_images(k)?);
+        for scale in [0.0, 0.3, 1.0] {
+            let (p, c) = t.search(&gt_params[k], scale);
+            println!("frame {k}: search from the true pose (spread ×{scale}) ends {:.1} mm away, cost {c:.3}", 1000.0 * mpjpe(&t.joints(&p), &gt[k]));
+        }
+    }
+    t.start_at(&seq.frame_images(0)?, &gt_params[0]);
+    let t0 = std::time::Instant::now();
+    let mut line = String::from("from truth:");
+    for k in 1..frames.min(seq.frames) {
+        let (p, _) = t.track(&seq.frame_images(k)?);
+        line += &format!(" {:.0}", 1000.0 * mpjpe(&t.joints(&p), &gt[k]));
+    }
+    println!(
+        "{line}  ({:.2} s/frame)",
+        t0.elapsed().as_secs_f64() / frames as f64
+    );
+    Ok(())
+}
+
+/// Median backgrounds, or with a third argument `plate:BVH` the empty scene rendered with the
+/// sequence's seed.
+fn backgrounds_for(
+    seq: &Sequence,
+    args: &[String],
+) -> Result<Vec<emilion::tracking::pyramid::Level>, Box<dyn std::error::Error>> {
+    if args.get(3).map(String::as_str) == Some("plate") {
+        let dir = std::env::temp_dir().join("emilion_plate_diag");
+        let o = emilion::tracking::sequence::SequenceOptions {
+            frames: Some(1),
+            body: false,
+            ..Default::default()
+        };
+        emilion::tracking::sequence::make_sequence(Path::new(&args[2]), &dir, &o)?;
+        let plate = Sequence::open(&dir)?;
+        return Ok(plate
+            .frame_images(0)?
+            .iter()
+            .map(emilion::tracking::pyramid::Level::from_image)
+            .collect());
+    }
+    if let Some(plates) = seq.background_plates()? {
+        return Ok(plates
+            .iter()
+            .map(emilion::tracking::pyramid::Level::from_image)
+            .collect());
+    }
+    Ok(sequence_backgrounds(seq, seq.frames, 25)?)
+}

@@ -1,0 +1,188 @@
+//! Pre-positioning of the tracking puppet: the least-squares fit of its pose parameters to
+//! 3D tracking joints, within the joint limits ([`Puppet::fit_to_joints`]). A child module of
+//! [`super`] (declared there with a `path` attribute), so it reaches the puppet's fields.
+
+use nalgebra::{DMatrix, DVector, Matrix3, UnitQuaternion};
+
+use super::{Puppet, PARAM_COUNT};
+use crate::body::Pose;
+use crate::geometry::Vec3;
+use crate::tracking::joints::JOINT_COUNT;
+
+/// Tracking joints used to place the trunk first: pelvis, spine, neck, shoulders, hips.
+const TRUNK: [usize; 7] = [0, 1, 2, 4, 7, 10, 13];
+
+/// Weight (metres per radian) pulling limb and trunk rotations toward the start values, so
+/// rotations no tracking joint sees (twists, hands, feet) stay put.
+const PRIOR: f64 = 0.01;
+
+/// Best rigid motion `x ↦ r x + t` taking the first points onto the second (Kabsch).
+fn kabsch(pairs: &[(Vec3, Vec3)]) -> Option<(UnitQuaternion<f64>, Vec3)> {
+    let n = pairs.len() as f64;
+    let ca = pairs.iter().map(|p| p.0).sum::<Vec3>() / n;
+    let cb = pairs.iter().map(|p| p.1).sum::<Vec3>() / n;
+    let h: Matrix3<f64> = pairs
+        .iter()
+        .map(|(a, b)| (a - ca) * (b - cb).transpose())
+        .sum();
+    let svd = h.try_svd(true, true, 1e-12, 100)?;
+    let (u, vt) = (svd.u?, svd.v_t?);
+    let mut d = Matrix3::identity();
+    if (vt.transpose() * u.transpose()).determinant() < 0.0 {
+        d[(2, 2)] = -1.0;
+    }
+    let r = vt.transpose() * d * u.transpose();
+    let q = UnitQuaternion::from_matrix(&r);
+    Some((q, cb - q * ca))
+}
+
+impl Puppet {
+    /// Pre-positioning: the parameters, within the limits, whose tracking joints are closest
+    /// (least squares) to `target`, starting from `start` (padded with zeros if short).
+    /// First the root is placed by a rigid fit of the trunk joints (kept only if better than
+    /// `start`), then root and chest are refined on the trunk joints, then all parameters on
+    /// all joints (projected Levenberg–Marquardt, forward-difference Jacobian), with a weak
+    /// pull toward `start` for what no joint sees. Non-finite target joints are ignored.
+    pub fn fit_to_joints(&self, target: &[Vec3; JOINT_COUNT], start: &[f64]) -> Vec<f64> {
+        let mut p: Vec<f64> = (0..PARAM_COUNT)
+            .map(|i| start.get(i).copied().unwrap_or(0.0))
+            .collect();
+        self.clamp(&mut p);
+        let valid: Vec<usize> = (0..JOINT_COUNT)
+            .filter(|&k| target[k].iter().all(|x| x.is_finite()))
+            .collect();
+        let trunk: Vec<usize> = TRUNK
+            .iter()
+            .copied()
+            .filter(|k| valid.contains(k))
+            .collect();
+        if valid.is_empty() {
+            return p;
+        }
+        let mut pose = Pose::identity(self.heads.len());
+        let prior = p.clone();
+        if trunk.len() >= 3 {
+            let mut q = p.clone();
+            q[0..6].fill(0.0);
+            self.pose_into(&q, &mut pose);
+            let j = self.joints(&pose);
+            let pairs: Vec<(Vec3, Vec3)> = trunk.iter().map(|&k| (j[k], target[k])).collect();
+            if let Some((r, t)) = kabsch(&pairs) {
+                // x ↦ r x + t as a root motion x ↦ R (x − h) + h + d
+                let h = self.heads[self.root];
+                let d = t + r * h - h;
+                q[0..3].copy_from_slice(d.as_slice());
+                q[3..6].copy_from_slice(r.scaled_axis().as_slice());
+                self.clamp(&mut q);
+                let cost = |x: &[f64], pose: &mut Pose| {
+                    self.pose_into(x, pose);
+                    let j = self.joints(pose);
+                    trunk
+                        .iter()
+                        .map(|&k| (j[k] - target[k]).norm_squared())
+                        .sum::<f64>()
+                };
+                if cost(&q, &mut pose) < cost(&p, &mut pose) {
+                    p = q;
+                }
+            }
+            let torso: Vec<usize> = (0..9).collect();
+            self.levenberg_marquardt(&mut p, &torso, &trunk, target, &prior, &mut pose, 30);
+        }
+        let all: Vec<usize> = (0..PARAM_COUNT).collect();
+        self.levenberg_marquardt(&mut p, &all, &valid, target, &prior, &mut pose, 100);
+        p
+    }
+
+    /// Residuals: joint offsets, then `PRIOR`-weighted pulls of active non-root parameters.
+    #[allow(clippy::too_many_arguments)]
+    fn residual(
+        &self,
+        p: &[f64],
+        active: &[usize],
+        joints: &[usize],
+        target: &[Vec3; JOINT_COUNT],
+        prior: &[f64],
+        pose: &mut Pose,
+        out: &mut DVector<f64>,
+    ) {
+        self.pose_into(p, pose);
+        let j = self.joints(pose);
+        for (r, &k) in joints.iter().enumerate() {
+            let e = j[k] - target[k];
+            out.fixed_rows_mut::<3>(3 * r).copy_from(&e);
+        }
+        let pulls = active.iter().filter(|&&i| i >= 6);
+        for (r, &i) in (3 * joints.len()..).zip(pulls) {
+            out[r] = PRIOR * (p[i] - prior[i]);
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn levenberg_marquardt(
+        &self,
+        p: &mut [f64],
+        active: &[usize],
+        joints: &[usize],
+        target: &[Vec3; JOINT_COUNT],
+        prior: &[f64],
+        pose: &mut Pose,
+        iterations: usize,
+    ) {
+        let m = 3 * joints.len() + active.iter().filter(|&&i| i >= 6).count();
+        let n = active.len();
+        let mut r = DVector::zeros(m);
+        let mut r2 = DVector::zeros(m);
+        let mut jac = DMatrix::zeros(m, n);
+        self.residual(p, active, joints, target, prior, pose, &mut r);
+        let mut cost = r.norm_squared();
+        let mut mu = 1e-3;
+        let mut q = p.to_vec();
+        for _ in 0..iterations {
+            for (c, &i) in active.iter().enumerate() {
+                q.copy_from_slice(p);
+                let h = if p[i] + 1e-6 > self.params[i].hi {
+                    -1e-6
+                } else {
+                    1e-6
+                };
+                q[i] += h;
+                self.residual(&q, active, joints, target, prior, pose, &mut r2);
+                jac.set_column(c, &((&r2 - &r) / h));
+            }
+            let jtj = jac.tr_mul(&jac);
+            let g = jac.tr_mul(&r);
+            let mut improved = false;
+            for _ in 0..12 {
+                let mut a = jtj.clone();
+                for d in 0..n {
+                    a[(d, d)] += mu * (jtj[(d, d)] + 1e-6);
+                }
+                let Some(ch) = a.cholesky() else {
+                    mu *= 4.0;
+                    continue;
+                };
+                let delta = ch.solve(&-&g);
+                q.copy_from_slice(p);
+                for (c, &i) in active.iter().enumerate() {
+                    q[i] += delta[c];
+                }
+                self.clamp(&mut q);
+                self.residual(&q, active, joints, target, prior, pose, &mut r2);
+                let c2 = r2.norm_squared();
+                if c2 < cost {
+                    improved = cost - c2 > 1e-14 * cost.max(1e-12);
+                    p.copy_from_slice(&q);
+                    std::mem::swap(&mut r, &mut r2);
+                    cost = c2;
+                    mu = (mu / 3.0).max(1e-9);
+                    break;
+                }
+                mu *= 4.0;
+            }
+            if !improved {
+                break;
+            }
+        }
+    }
+}

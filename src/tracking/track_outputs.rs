@@ -1,0 +1,144 @@
+//! Everything a tracking run writes: the tracked motion (BVH and joint CSV), the broadcast
+//! overlay pictures (every camera with the skeleton drawn, the ground truth too when known),
+//! the swing metrics (CSV and plots), per-frame errors against the ground truth, and a
+//! JSON summary with the time per stage.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use super::bvh_export::{write_bvh, write_joints_csv, TrackingOutputError};
+use super::joints::{joint_index, TRACKING_JOINTS};
+use super::overlay::write_overlay_png;
+use super::sequence_files::{Sequence, SequenceError};
+use super::swing_metrics::{swing_metrics, write_swing_metrics};
+use super::tracker::TrackResult;
+
+/// What to write.
+#[derive(Clone, Debug)]
+pub struct TrackOutputOptions {
+    /// Write an overlay picture every this many frames (0: none).
+    pub overlay_every: usize,
+}
+
+impl Default for TrackOutputOptions {
+    fn default() -> Self {
+        TrackOutputOptions { overlay_every: 1 }
+    }
+}
+
+/// Errors of writing the outputs.
+#[derive(Debug, thiserror::Error)]
+pub enum TrackOutputError {
+    /// A tracking output failed (names the file).
+    #[error(transparent)]
+    Output(#[from] TrackingOutputError),
+    /// Reading the sequence's images failed.
+    #[error(transparent)]
+    Sequence(#[from] SequenceError),
+    /// A folder or file could not be written.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The path.
+        path: PathBuf,
+        /// The error.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+fn io(path: &Path) -> impl FnOnce(std::io::Error) -> TrackOutputError + '_ {
+    move |source| TrackOutputError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// The arm joints (elbows and wrists), the seed report's focus.
+pub fn arm_joints() -> Vec<usize> {
+    ["l_elbow", "l_wrist", "r_elbow", "r_wrist"]
+        .iter()
+        .filter_map(|n| joint_index(n))
+        .collect()
+}
+
+/// The summary of a run as JSON text.
+pub fn summary_json(seq: &Sequence, result: &TrackResult) -> String {
+    let stages: serde_json::Map<String, serde_json::Value> = result
+        .stage_seconds
+        .iter()
+        .map(|(k, v)| {
+            (
+                k.clone(),
+                serde_json::json!(v / result.frame_seconds.len().max(1) as f64),
+            )
+        })
+        .collect();
+    let v = serde_json::json!({
+        "sequence": seq.dir.display().to_string(),
+        "frames": result.joints.len(),
+        "cameras": seq.cameras.len(),
+        "mpjpe_mm": result.mpjpe_mm(),
+        "max_frame_mm": result.errors_mm.as_ref().map(|e| e.iter().cloned().fold(0.0, f64::max)),
+        "arm_mm": result.joints_error_mm(&arm_joints()),
+        "seconds_per_frame": result.seconds_per_frame(),
+        "seconds_per_frame_by_stage": stages,
+        "io_seconds_per_frame": result.io_seconds / result.joints.len().max(1) as f64,
+        "start_seconds": result.start_seconds,
+        "evaluations_per_frame": result.evaluations as f64 / result.frame_seconds.len().max(1) as f64,
+    });
+    serde_json::to_string_pretty(&v).unwrap_or_default()
+}
+
+/// Writes the outputs of `result` (tracked from `seq`) under `out`; returns the files.
+pub fn write_track_outputs(
+    seq: &Sequence,
+    result: &TrackResult,
+    out: &Path,
+    options: &TrackOutputOptions,
+) -> Result<Vec<PathBuf>, TrackOutputError> {
+    std::fs::create_dir_all(out).map_err(io(out))?;
+    let mut files = Vec::new();
+    let joints = out.join("tracked_joints.csv");
+    write_joints_csv(&joints, &result.joints, seq.fps)?;
+    files.push(joints);
+    let bvh = out.join("tracked.bvh");
+    write_bvh(&bvh, &result.joints, seq.fps)?;
+    files.push(bvh);
+    files.extend(write_swing_metrics(
+        out,
+        "swing_metrics",
+        &swing_metrics(&result.joints, seq.fps),
+    )?);
+    if let (Some(frames), Some(joints)) = (&result.errors_mm, &result.joint_errors_mm) {
+        let path = out.join("errors.csv");
+        let mut s = String::from("frame,mpjpe_mm");
+        for t in &TRACKING_JOINTS {
+            let _ = write!(s, ",{}_mm", t.name);
+        }
+        s.push('\n');
+        for (k, (e, j)) in frames.iter().zip(joints).enumerate() {
+            let _ = write!(s, "{k},{e:.3}");
+            for x in j {
+                let _ = write!(s, ",{x:.3}");
+            }
+            s.push('\n');
+        }
+        std::fs::write(&path, s).map_err(io(&path))?;
+        files.push(path);
+    }
+    if options.overlay_every > 0 {
+        let dir = out.join("overlay");
+        std::fs::create_dir_all(&dir).map_err(io(&dir))?;
+        for k in (0..result.joints.len()).step_by(options.overlay_every) {
+            let images = seq.frame_images(k)?;
+            let truth = seq.ground_truth.as_ref().and_then(|g| g.get(k));
+            let path = dir.join(format!("{k:04}.png"));
+            write_overlay_png(&path, &images, &seq.cameras, &result.joints[k], truth)?;
+            files.push(path);
+        }
+    }
+    let path = out.join("summary.json");
+    std::fs::write(&path, summary_json(seq, result)).map_err(io(&path))?;
+    files.push(path);
+    Ok(files)
+}

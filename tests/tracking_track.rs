@@ -1,0 +1,108 @@
+//! The body tracker end to end, through its scripts: a short punch sequence made by
+//! `scripts/make_sequence.rhai` (4 cameras, 320×240, clutter, noise, changing light, a 10 %
+//! occluder) is tracked by `scripts/track_body.rhai`, and the tracked joints are compared
+//! with the ground truth the sequence was made from.
+
+use std::path::PathBuf;
+
+use emilion::script::run_file;
+use emilion::tracking::sequence_files::{read_joints_csv, Sequence};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn temp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("emilion_track_{name}_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn sets(pairs: &[(&str, &str)]) -> Vec<(String, String)> {
+    pairs
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect()
+}
+
+#[test]
+fn punch_is_tracked_within_40_mm() {
+    let dir = temp("punch");
+    let seq = dir.join("seq");
+    let out = dir.join("track");
+    let motion = root().join("../shared/data/motion/cmu_bvh/002_05.bvh");
+    run_file(
+        &root().join("scripts/make_sequence.rhai"),
+        &sets(&[
+            ("motion", motion.to_str().unwrap()),
+            ("out", seq.to_str().unwrap()),
+            ("frames", "8"),
+        ]),
+    )
+    .unwrap_or_else(|e| panic!("make_sequence.rhai: {e}"));
+    run_file(
+        &root().join("scripts/track_body.rhai"),
+        &sets(&[
+            ("seq", seq.to_str().unwrap()),
+            ("out", out.to_str().unwrap()),
+            ("overlay_every", "4"),
+        ]),
+    )
+    .unwrap_or_else(|e| panic!("track_body.rhai: {e}"));
+    // the tracked joints, read back, against the ground truth
+    let s = Sequence::open(&seq).unwrap();
+    let truth = s.ground_truth.as_ref().unwrap();
+    let tracked = read_joints_csv(&out.join("tracked_joints.csv")).unwrap();
+    assert_eq!(tracked.len(), 8);
+    let errors: Vec<f64> = tracked
+        .iter()
+        .map(|(k, _, j)| {
+            1000.0
+                * j.iter()
+                    .zip(&truth[*k])
+                    .map(|(a, b)| (a - b).norm())
+                    .sum::<f64>()
+                / 16.0
+        })
+        .collect();
+    let mean = errors.iter().sum::<f64>() / errors.len() as f64;
+    let worst = errors.iter().cloned().fold(0.0, f64::max);
+    assert!(
+        mean <= 40.0 && worst <= 120.0,
+        "per-frame errors (mm): {errors:.1?}"
+    );
+    for f in [
+        "tracked.bvh",
+        "summary.json",
+        "errors.csv",
+        "swing_metrics.csv",
+        "overlay/0000.png",
+        "overlay/0004.png",
+    ] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_sequence_without_cameras_is_a_clear_error() {
+    let dir = temp("nocam");
+    let seq = dir.join("seq");
+    run_file(
+        &root().join("scripts/make_sequence.rhai"),
+        &sets(&[("out", seq.to_str().unwrap()), ("frames", "1")]),
+    )
+    .unwrap();
+    std::fs::remove_file(seq.join("cameras/cam2.json")).unwrap();
+    let e = run_file(
+        &root().join("scripts/track_body.rhai"),
+        &sets(&[
+            ("seq", seq.to_str().unwrap()),
+            ("out", dir.join("t").to_str().unwrap()),
+        ]),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("cam2.json"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
