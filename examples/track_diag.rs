@@ -1,6 +1,8 @@
-//! Diagnostics of the tracker's cost on a sequence made from a BVH clip: the cost at the
-//! true pose against perturbed poses, and annealing started from the true pose.
-//! `cargo run --release --example track_diag -- SEQ_DIR CLIP.bvh [background: median|plate]`
+//! Diagnostics of the tracker on a sequence made from a BVH clip: that the puppet reproduces
+//! the ground truth, the cost at the true pose against perturbed poses (per parameter and
+//! pyramid level), searches started from the true pose and from perturbed ones, the start
+//! (pre-positioning) per joint, and with a third argument, tracking from the true first pose.
+//! `cargo run --release --example track_diag -- SEQ_DIR CLIP.bvh [truth]`
 
 use std::path::Path;
 
@@ -16,6 +18,9 @@ use emilion::tracking::tracker::sequence_backgrounds;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
+    if args.len() < 3 {
+        return Err("usage: track_diag SEQ_DIR CLIP.bvh [truth]".into());
+    }
     let seq = Sequence::open(&args[1])?;
     let mannequin = Mannequin::load_makehuman(Path::new("../shared/data/bodies/makehuman"))?;
     let motion = Motion::load_bvh(Path::new(&args[2]))?;
@@ -90,7 +95,41 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             println!("{line}");
         }
     }
-    track_from_truth(&seq, &mannequin, &gt_params, 20, Default::default())?;
+    if let Some(init) = &seq.init_joints {
+        let fit = puppet.fit_to_joints(init, &puppet.rest_params());
+        puppet.pose_into(&fit, &mut ws.pose);
+        println!(
+            "fit to the init joints: {:.1} mm from the truth",
+            1000.0 * mpjpe(&puppet.joints(&ws.pose), &gt[0])
+        );
+        let backgrounds = backgrounds_for(&seq, &args)?;
+        let mut t = emilion::tracking::tracker::Tracker::new(
+            &mannequin,
+            &seq.cameras,
+            &backgrounds,
+            Default::default(),
+        )?;
+        let p = t.start(&seq.frame_images(0)?, init)?;
+        println!(
+            "after the start: {:.1} mm",
+            1000.0 * mpjpe(&t.joints(&p), &gt[0])
+        );
+        let names = emilion::tracking::joints::TRACKING_JOINTS;
+        let fj = puppet.joints(&ws.pose);
+        let sj = t.joints(&p);
+        for k in 0..16 {
+            println!(
+                "  {:10} init {:5.1} fit {:5.1} start {:5.1} mm",
+                names[k].name,
+                1000.0 * (init[k] - gt[0][k]).norm(),
+                1000.0 * (fj[k] - gt[0][k]).norm(),
+                1000.0 * (sj[k] - gt[0][k]).norm()
+            );
+        }
+    }
+    if args.len() > 3 {
+        track_from_truth(&seq, &mannequin, &gt_params, 20, Default::default())?;
+    }
     Ok(())
 }
 
@@ -107,8 +146,27 @@ pub fn track_from_truth(
         emilion::tracking::tracker::Tracker::new(mannequin, &seq.cameras, &backgrounds, options)?;
     let gt = seq.ground_truth.as_ref().ok_or("no ground truth")?;
     t.start_at(&seq.frame_images(0)?, &gt_params[0]);
+    let mut rng = emilion::geometry::SplitMix64::new(5);
     for k in [1usize, 5, 10] {
         t.set_frame(&seq.frame_images(k)?);
+        for noise in [0.02, 0.05, 0.1] {
+            let mut p0 = gt_params[k].clone();
+            for (i, v) in p0.iter_mut().enumerate() {
+                *v += if i < 3 { noise * 0.3 } else { noise } * rng.normal();
+            }
+            let e0 = 1000.0 * mpjpe(&t.joints(&p0), &gt[k]);
+            let (p1, _) = t.search(&p0, 1.0);
+            let (p2, _) = t.search(&p1, 0.35);
+            let (p3, _) = t.search(&p2, 0.15);
+            let (p4, _) = t.search(&p3, 0.07);
+            println!(
+                "frame {k}: from {e0:.1} mm off: passes {:.1} {:.1} {:.1} {:.1} mm",
+                1000.0 * mpjpe(&t.joints(&p1), &gt[k]),
+                1000.0 * mpjpe(&t.joints(&p2), &gt[k]),
+                1000.0 * mpjpe(&t.joints(&p3), &gt[k]),
+                1000.0 * mpjpe(&t.joints(&p4), &gt[k])
+            );
+        }
         for scale in [0.0, 0.3, 1.0] {
             let (p, c) = t.search(&gt_params[k], scale);
             println!("frame {k}: search from the true pose (spread ×{scale}) ends {:.1} mm away, cost {c:.3}", 1000.0 * mpjpe(&t.joints(&p), &gt[k]));
@@ -128,27 +186,11 @@ pub fn track_from_truth(
     Ok(())
 }
 
-/// Median backgrounds, or with a third argument `plate:BVH` the empty scene rendered with the
-/// sequence's seed.
+/// The sequence's clean plates, or the median of its frames.
 fn backgrounds_for(
     seq: &Sequence,
-    args: &[String],
+    _args: &[String],
 ) -> Result<Vec<emilion::tracking::pyramid::Level>, Box<dyn std::error::Error>> {
-    if args.get(3).map(String::as_str) == Some("plate") {
-        let dir = std::env::temp_dir().join("emilion_plate_diag");
-        let o = emilion::tracking::sequence::SequenceOptions {
-            frames: Some(1),
-            body: false,
-            ..Default::default()
-        };
-        emilion::tracking::sequence::make_sequence(Path::new(&args[2]), &dir, &o)?;
-        let plate = Sequence::open(&dir)?;
-        return Ok(plate
-            .frame_images(0)?
-            .iter()
-            .map(emilion::tracking::pyramid::Level::from_image)
-            .collect());
-    }
     if let Some(plates) = seq.background_plates()? {
         return Ok(plates
             .iter()

@@ -26,7 +26,7 @@ fn sets(pairs: &[(&str, &str)]) -> Vec<(String, String)> {
 }
 
 #[test]
-fn punch_is_tracked_within_40_mm() {
+fn punch_is_tracked_without_losing_it() {
     let dir = temp("punch");
     let seq = dir.join("seq");
     let out = dir.join("track");
@@ -104,5 +104,58 @@ fn a_sequence_without_cameras_is_a_clear_error() {
     .unwrap_err()
     .to_string();
     assert!(e.contains("cam2.json"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_bvh_with_unknown_joints_is_a_clear_error() {
+    let dir = temp("bvh");
+    std::fs::create_dir_all(&dir).unwrap();
+    // a valid BVH on the classic CMU skeleton names, which the retargeting does not know
+    let bvh = dir.join("classic.bvh");
+    std::fs::write(
+        &bvh,
+        "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 6 Xposition Yposition Zposition \
+         Zrotation Xrotation Yrotation\n  JOINT LeftUpLeg\n  {\n    OFFSET 10 0 0\n    \
+         CHANNELS 3 Zrotation Xrotation Yrotation\n    End Site\n    {\n      OFFSET 0 -40 0\n    \
+         }\n  }\n}\nMOTION\nFrames: 2\nFrame Time: 0.0083333\n0 90 0 0 0 0 0 0 0\n\
+         0 90 0 0 0 0 10 0 0\n",
+    )
+    .unwrap();
+    let e = run_file(
+        &root().join("scripts/make_sequence.rhai"),
+        &sets(&[
+            ("motion", bvh.to_str().unwrap()),
+            ("out", dir.join("seq").to_str().unwrap()),
+        ]),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("classic") && e.contains("missing"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn an_image_of_the_wrong_size_is_a_clear_error() {
+    let dir = temp("size");
+    let seq = dir.join("seq");
+    run_file(
+        &root().join("scripts/make_sequence.rhai"),
+        &sets(&[("out", seq.to_str().unwrap()), ("frames", "1")]),
+    )
+    .unwrap();
+    image::RgbImage::new(100, 50)
+        .save(seq.join("backgrounds/cam1.png"))
+        .unwrap();
+    let e = run_file(
+        &root().join("scripts/track_body.rhai"),
+        &sets(&[
+            ("seq", seq.to_str().unwrap()),
+            ("out", dir.join("t").to_str().unwrap()),
+        ]),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("cam1.png") && e.contains("100"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -8,6 +8,8 @@
 //! - [`contact`]: collision bodies, the mannequin, friction, contact settings and read-outs;
 //! - [`output`]: positions, bounds, energies, OBJ/glTF/CSV/JSON/PNG output;
 //! - [`kes`]: the virtual Kawabata lab (fabric files, rigs, fitting, summaries);
+//! - [`facade`], [`facade_analysis`]: facade label maps, scores and the photo pipeline;
+//! - [`tracking_sequence`], [`tracking`]: synthetic multi-camera sequences and the body tracker;
 //! - [`run`], [`repl`], [`docs`]: running a file, the interactive loop, API documentation.
 //!
 //! Big objects cross into Rhai as shared handles (`Shared<Locked<_>>`), never copied per call.

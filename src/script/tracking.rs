@@ -30,6 +30,15 @@ fn options(m: &Map) -> RResult<(TrackerOptions, TrackOutputOptions, Option<Strin
                     .map(|d| count(d, "layers[]"))
                     .collect::<RResult<Vec<_>>>()?;
             }
+            "passes" => {
+                let arr = v
+                    .read_lock::<rhai::Array>()
+                    .ok_or_else(|| rt_err("`passes` must be an array of spread factors"))?;
+                o.passes = arr
+                    .iter()
+                    .map(|d| finite(d, "passes[]"))
+                    .collect::<RResult<Vec<_>>>()?;
+            }
             "robust_sigma" => o.robust_sigma = finite(v, "robust_sigma")? as f32,
             "mesh_cell" => o.mesh_cell = finite(v, "mesh_cell")?,
             "lbs" => {
@@ -43,13 +52,11 @@ fn options(m: &Map) -> RResult<(TrackerOptions, TrackOutputOptions, Option<Strin
             "frames" => o.frames = Some(count(v, "frames")?),
             "overlay_every" => out.overlay_every = count(v, "overlay_every")?,
             "makehuman" => makehuman = Some(v.to_string()),
-            other => {
-                return Err(rt_err(format!(
-                    "track_body: unknown option `{other}` (particles, layers, robust_sigma, \
+            other => return Err(rt_err(format!(
+                "track_body: unknown option `{other}` (particles, layers, passes, robust_sigma, \
                      mesh_cell, lbs, background_frames, prediction, seed, frames, \
                      overlay_every, makehuman)"
-                )))
-            }
+            ))),
         }
     }
     Ok((o, out, makehuman))
@@ -135,6 +142,7 @@ truth), s_per_frame, stage_seconds (per frame), start_seconds, files}.",
 of each annealing layer, coarse first, e.g. [1, 1, 1, 0, 0]), `robust_sigma` (grey levels),
 `mesh_cell` (metres), `lbs` (linear blend skinning instead of rigid), `background_frames`,
 `prediction` (velocity factor), `seed`, `frames` (track only the first frames),
+`passes` (spread factor of each pass of the stage hierarchy per frame, e.g. [1.0, 0.35]),
 `overlay_every` (0: no pictures), `makehuman` (folder of the body model).",
         |seq: &str, out: &str, m: Map| track(seq, out, &m)
     );

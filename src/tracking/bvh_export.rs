@@ -392,10 +392,7 @@ pub fn joints_csv_string(
     fps: f64,
 ) -> Result<String, TrackingOutputError> {
     validate_frames(frames, fps)?;
-    let mut s = String::from("frame,time");
-    for t in &TRACKING_JOINTS {
-        let _ = write!(s, ",{0}_x,{0}_y,{0}_z", t.name);
-    }
+    let mut s = super::sequence_files::joints_csv_header();
     s.push('\n');
     for (f, frame) in frames.iter().enumerate() {
         let _ = write!(s, "{f},{}", f as f64 / fps);

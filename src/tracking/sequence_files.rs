@@ -318,12 +318,7 @@ impl Sequence {
                 what: what.to_string(),
             });
         }
-        let img = image::open(path)
-            .map_err(|e| SequenceError::Image {
-                path: path.to_path_buf(),
-                message: e.to_string(),
-            })?
-            .into_rgb8();
+        let img = read_rgb(path)?;
         if img.dimensions() != (cam.width, cam.height) {
             return Err(SequenceError::ImageSize {
                 path: path.to_path_buf(),
@@ -529,6 +524,16 @@ pub(crate) fn list_photos(dir: &Path) -> Result<Vec<PathBuf>, SequenceError> {
     Ok(photos)
 }
 
+/// An image file as 8-bit RGB; the error names the file.
+fn read_rgb(path: &Path) -> Result<RgbImage, SequenceError> {
+    Ok(image::open(path)
+        .map_err(|e| SequenceError::Image {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?
+        .into_rgb8())
+}
+
 /// `photo` scaled to cover `w × h` and cropped at a seeded place.
 pub(crate) fn cover(
     path: &Path,
@@ -536,12 +541,7 @@ pub(crate) fn cover(
     h: u32,
     rng: &mut SplitMix64,
 ) -> Result<RgbImage, SequenceError> {
-    let img = image::open(path)
-        .map_err(|e| SequenceError::Image {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })?
-        .into_rgb8();
+    let img = read_rgb(path)?;
     let (iw, ih) = (img.width().max(1) as f64, img.height().max(1) as f64);
     let s = (w as f64 / iw).max(h as f64 / ih);
     let (nw, nh) = (

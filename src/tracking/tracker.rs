@@ -47,7 +47,7 @@ pub enum TrackError {
 /// Tracker settings.
 #[derive(Clone, Debug)]
 pub struct TrackerOptions {
-    /// Particles per annealing layer.
+    /// Particles per annealing layer (torso and head; the limb stages use half as many again).
     pub particles: usize,
     /// Pyramid level of each annealing layer of a stage (coarse first).
     pub layers: Vec<usize>,
@@ -65,6 +65,11 @@ pub struct TrackerOptions {
     pub seed: u64,
     /// Track at most this many frames (from frame 0).
     pub frames: Option<usize>,
+    /// Passes of the stage hierarchy per frame, as factors of the move spreads (a wide
+    /// search, then a narrower one that refines the torso with the limbs in place).
+    pub passes: Vec<f64>,
+    /// Weight of the motion prior (per squared move spread of a parameter).
+    pub prior_weight: f64,
 }
 
 impl Default for TrackerOptions {
@@ -73,12 +78,14 @@ impl Default for TrackerOptions {
             particles: 32,
             layers: vec![1, 1, 1, 0, 0],
             robust_sigma: 40.0,
-            mesh_cell: 0.03,
+            mesh_cell: super::puppet_mesh::DEFAULT_CELL,
             lbs: false,
             background_frames: 25,
             prediction: 0.7,
             seed: 1,
             frames: None,
+            passes: vec![1.0, 0.35],
+            prior_weight: 0.05,
         }
     }
 }
@@ -154,19 +161,19 @@ const STAGES: &[Stage] = &[
     },
     Stage {
         name: "left arm",
-        groups: &[PartGroup::LeftArm],
+        groups: &[PartGroup::LeftArm, PartGroup::LeftHand],
     },
     Stage {
         name: "right arm",
-        groups: &[PartGroup::RightArm],
+        groups: &[PartGroup::RightArm, PartGroup::RightHand],
     },
     Stage {
         name: "left leg",
-        groups: &[PartGroup::LeftLeg],
+        groups: &[PartGroup::LeftLeg, PartGroup::LeftFoot],
     },
     Stage {
         name: "right leg",
-        groups: &[PartGroup::RightLeg],
+        groups: &[PartGroup::RightLeg, PartGroup::RightFoot],
     },
 ];
 
@@ -256,7 +263,22 @@ impl Tracker {
     /// Runs the stages on the current frame from `start` (move spreads scaled by
     /// `sigma_scale`); returns the pose and its cost.
     pub fn search(&mut self, start: &[f64], sigma_scale: f64) -> (Vec<f64>, f64) {
-        let settings = AnnealSettings {
+        let centre = start.to_vec();
+        self.search_with_prior(start, sigma_scale, &centre)
+    }
+
+    /// [`search`](Self::search) with the motion prior centred on `centre` (the prediction):
+    /// `prior_weight · Σ ((p − centre) / spread)²` over the parameters a stage moves, added
+    /// to the image cost, keeps what the images hardly see (an occluded leg) where the
+    /// motion so far puts it.
+    pub fn search_with_prior(
+        &mut self,
+        start: &[f64],
+        sigma_scale: f64,
+        centre: &[f64],
+    ) -> (Vec<f64>, f64) {
+        let prior_weight = self.options.prior_weight;
+        let mut settings = AnnealSettings {
             particles: self.options.particles,
             levels: self.options.layers.clone(),
             ..Default::default()
@@ -272,6 +294,16 @@ impl Tracker {
             if dofs.is_empty() {
                 continue;
             }
+            let spread: Vec<f64> = dofs
+                .iter()
+                .map(|&k| move_sigma(k, infos[k].group))
+                .collect();
+            // limbs move fastest and are the most often hidden: half as many particles again
+            settings.particles = if s >= 2 {
+                self.options.particles * 3 / 2
+            } else {
+                self.options.particles
+            };
             let sigma: Vec<f64> = dofs
                 .iter()
                 .map(|&k| sigma_scale * move_sigma(k, infos[k].group))
@@ -298,7 +330,12 @@ impl Tracker {
                         Ok(g) => g,
                         Err(poisoned) => poisoned.into_inner(),
                     };
-                    pose_cost(&app, views, level, p, &mut ws)
+                    let prior: f64 = dofs
+                        .iter()
+                        .zip(&spread)
+                        .map(|(&k, s)| ((p[k] - centre[k]) / s).powi(2))
+                        .sum();
+                    pose_cost(&app, views, level, p, &mut ws) + prior_weight * prior
                 },
                 &mut self.scratch,
             );
@@ -350,10 +387,13 @@ impl Tracker {
         let rest = self.puppet.rest_params();
         let fitted = self.puppet.fit_to_joints(approx, &rest);
         self.colours = None;
-        let (silhouette, _) = self.search(&fitted, 0.3);
-        self.learn(&silhouette);
-        let (refined, _) = self.search(&silhouette, 0.3);
-        self.learn(&refined);
+        let mut pose = fitted.clone();
+        for scale in [0.4, 0.3, 0.2, 0.15, 0.1] {
+            self.learn(&pose);
+            (pose, _) = self.search_with_prior(&pose, scale, &fitted);
+        }
+        self.learn(&pose);
+        let refined = pose;
         self.history = vec![refined.clone()];
         Ok(refined)
     }
@@ -385,7 +425,10 @@ impl Tracker {
             }
             self.puppet.clamp(&mut predicted);
         }
-        let (params, cost) = self.search(&predicted, 1.0);
+        let (mut params, mut cost) = (predicted.clone(), f64::INFINITY);
+        for k in 0..self.options.passes.len() {
+            (params, cost) = self.search_with_prior(&params, self.options.passes[k], &predicted);
+        }
         self.history.push(params.clone());
         if self.history.len() > 2 {
             self.history.remove(0);
@@ -402,6 +445,47 @@ impl Tracker {
         self.puppet.pose_into(params, &mut ws.pose);
         self.puppet.joints(&ws.pose)
     }
+}
+
+/// Pixels of each camera where the scene changes at some time: the image differs from the
+/// background (after its lighting gain) by more than `threshold` in robust distance in at
+/// least one of up to `count` frames spread over the sequence. The others are a static
+/// occluder or background the person never crosses (see
+/// [`ViewLevel::active`](super::cost::ViewLevel::active)).
+pub fn changing_pixels(
+    seq: &Sequence,
+    backgrounds: &[Level],
+    count: usize,
+    robust: Robust,
+    threshold: f32,
+) -> Result<Vec<Vec<bool>>, TrackError> {
+    let frames = seq.frames;
+    let picks: Vec<usize> = if frames <= count.max(1) {
+        (0..frames).collect()
+    } else {
+        (0..count)
+            .map(|i| i * (frames - 1) / (count - 1).max(1))
+            .collect()
+    };
+    let mut masks: Vec<Vec<bool>> = backgrounds
+        .iter()
+        .map(|b| vec![false; b.rgb.len()])
+        .collect();
+    let mut scratch = Vec::new();
+    for &k in &picks {
+        for (c, img) in seq.frame_images(k)?.iter().enumerate() {
+            let level = Level::from_image(img);
+            let gain = super::pyramid::lighting_gain(&level, &backgrounds[c], &mut scratch)
+                .clamp(0.2, 5.0);
+            for ((m, p), b) in masks[c].iter_mut().zip(&level.rgb).zip(&backgrounds[c].rgb) {
+                let q = p.map(|v| v / gain);
+                if robust.rho_colours(&q, b) > threshold {
+                    *m = true;
+                }
+            }
+        }
+    }
+    Ok(masks)
 }
 
 /// Background model of every camera: the median of up to `count` frames spread evenly
@@ -458,6 +542,11 @@ pub fn track_sequence(
         None => sequence_backgrounds(seq, seq.frames, options.background_frames)?,
     };
     let mut tracker = Tracker::new(mannequin, &seq.cameras, &backgrounds, options.clone())?;
+    let robust = Robust {
+        sigma: options.robust_sigma,
+    };
+    let masks = changing_pixels(seq, &backgrounds, options.background_frames, robust, 0.2)?;
+    tracker.views.set_active(&masks);
     let mut result = TrackResult::default();
     let t_io = Instant::now();
     let images = seq.frame_images(0)?;
