@@ -175,9 +175,9 @@ pub fn track_from_truth(
     t.start_at(&seq.frame_images(0)?, &gt_params[0]);
     let t0 = std::time::Instant::now();
     let mut line = String::from("from truth:");
-    for k in 1..frames.min(seq.frames) {
+    for (k, truth) in gt.iter().enumerate().take(frames.min(seq.frames)).skip(1) {
         let (p, _) = t.track(&seq.frame_images(k)?);
-        line += &format!(" {:.0}", 1000.0 * mpjpe(&t.joints(&p), &gt[k]));
+        line += &format!(" {:.0}", 1000.0 * mpjpe(&t.joints(&p), truth));
     }
     println!(
         "{line}  ({:.2} s/frame)",

@@ -219,7 +219,8 @@ impl Tracker {
                 options.layers.len()
             )));
         }
-        if !(options.robust_sigma > 0.0) || !(options.mesh_cell > 0.0) {
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        if !positive(options.robust_sigma as f64) || !positive(options.mesh_cell) {
             return Err(TrackError::Invalid(
                 "tracker: robust_sigma and mesh_cell must be positive".into(),
             ));
