@@ -145,10 +145,10 @@ pub fn track_from_truth(
     let mut t =
         emilion::tracking::tracker::Tracker::new(mannequin, &seq.cameras, &backgrounds, options)?;
     let gt = seq.ground_truth.as_ref().ok_or("no ground truth")?;
-    t.start_at(&seq.frame_images(0)?, &gt_params[0]);
+    t.start_at(&seq.frame_images(0)?, &gt_params[0])?;
     let mut rng = emilion::geometry::SplitMix64::new(5);
     for k in [1usize, 5, 10] {
-        t.set_frame(&seq.frame_images(k)?);
+        t.set_frame(&seq.frame_images(k)?)?;
         for noise in [0.02, 0.05, 0.1] {
             let mut p0 = gt_params[k].clone();
             for (i, v) in p0.iter_mut().enumerate() {
@@ -172,11 +172,11 @@ pub fn track_from_truth(
             println!("frame {k}: search from the true pose (spread ×{scale}) ends {:.1} mm away, cost {c:.3}", 1000.0 * mpjpe(&t.joints(&p), &gt[k]));
         }
     }
-    t.start_at(&seq.frame_images(0)?, &gt_params[0]);
+    t.start_at(&seq.frame_images(0)?, &gt_params[0])?;
     let t0 = std::time::Instant::now();
     let mut line = String::from("from truth:");
     for (k, truth) in gt.iter().enumerate().take(frames.min(seq.frames)).skip(1) {
-        let (p, _) = t.track(&seq.frame_images(k)?);
+        let (p, _) = t.track(&seq.frame_images(k)?)?;
         line += &format!(" {:.0}", 1000.0 * mpjpe(&t.joints(&p), truth));
     }
     println!(

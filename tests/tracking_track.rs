@@ -159,3 +159,42 @@ fn an_image_of_the_wrong_size_is_a_clear_error() {
     assert!(e.contains("cam1.png") && e.contains("100"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_tracker_refuses_images_that_do_not_fit_its_cameras() {
+    use emilion::body::Mannequin;
+    use emilion::tracking::pyramid::Level;
+    use emilion::tracking::sequence::ring_cameras;
+    use emilion::tracking::tracker::{Tracker, TrackerOptions};
+    let mannequin =
+        Mannequin::load_makehuman(&root().join("../shared/data/bodies/makehuman")).unwrap();
+    let cameras = ring_cameras(2, 64, 48, emilion::geometry::Vec3::new(0.0, 0.0, 1.0)).unwrap();
+    let plate = Level::from_image(&image::RgbImage::new(64, 48));
+    // one background for two cameras
+    let e = Tracker::new(
+        &mannequin,
+        &cameras,
+        &[plate.clone()],
+        TrackerOptions::default(),
+    )
+    .err()
+    .unwrap()
+    .to_string();
+    assert!(e.contains("2 cameras but 1 background"), "{e}");
+    let mut t = Tracker::new(
+        &mannequin,
+        &cameras,
+        &[plate.clone(), plate],
+        TrackerOptions::default(),
+    )
+    .unwrap();
+    let e = t
+        .track(&[image::RgbImage::new(64, 48), image::RgbImage::new(32, 48)])
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains("camera 1 is 32×48") && e.contains("64×48"),
+        "{e}"
+    );
+}

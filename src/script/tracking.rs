@@ -52,11 +52,13 @@ fn options(m: &Map) -> RResult<(TrackerOptions, TrackOutputOptions, Option<Strin
             "frames" => o.frames = Some(count(v, "frames")?),
             "overlay_every" => out.overlay_every = count(v, "overlay_every")?,
             "makehuman" => makehuman = Some(v.to_string()),
-            other => return Err(rt_err(format!(
+            other => {
+                return Err(rt_err(format!(
                 "track_body: unknown option `{other}` (particles, layers, passes, robust_sigma, \
                      mesh_cell, lbs, background_frames, prediction, seed, frames, \
                      overlay_every, makehuman)"
-            ))),
+            )))
+            }
         }
     }
     Ok((o, out, makehuman))

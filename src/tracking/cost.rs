@@ -167,10 +167,11 @@ impl FrameViews {
     }
 
     /// Loads a new frame (one image per camera, sizes already checked): pyramid, lighting
-    /// gain against the background, and the background term.
+    /// gain against the background, and the background term. Images beyond the cameras
+    /// are ignored.
     pub fn set_frame(&mut self, images: &[RgbImage]) {
         let mut pyr = Vec::new();
-        for (c, img) in images.iter().enumerate() {
+        for (c, img) in images.iter().enumerate().take(self.views.len()) {
             let levels = self.views[c].len();
             build_pyramid(img, levels, &mut pyr);
             let gain = lighting_gain(&pyr[0], &self.views[c][0].background, &mut self.scratch)

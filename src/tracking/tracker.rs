@@ -225,6 +225,13 @@ impl Tracker {
                 "tracker: robust_sigma and mesh_cell must be positive".into(),
             ));
         }
+        if cameras.len() != backgrounds.len() || cameras.is_empty() {
+            return Err(TrackError::Invalid(format!(
+                "tracker: {} cameras but {} background images",
+                cameras.len(),
+                backgrounds.len()
+            )));
+        }
         let puppet = Puppet::new(mannequin).map_err(|e| TrackError::Puppet(e.to_string()))?;
         let mesh = TrackingMesh::build(mannequin, &puppet, options.mesh_cell);
         let levels = options.layers.iter().max().copied().unwrap_or(0) + 1;
@@ -400,23 +407,57 @@ impl Tracker {
     }
 
     /// Frame 0 from a known pose (no search): learns the colours there.
-    pub fn start_at(&mut self, images: &[RgbImage], params: &[f64]) -> Vec<f64> {
+    pub fn start_at(
+        &mut self,
+        images: &[RgbImage],
+        params: &[f64],
+    ) -> Result<Vec<f64>, TrackError> {
+        self.check_images(images)?;
         self.views.set_frame(images);
         let mut p = params.to_vec();
         self.puppet.clamp(&mut p);
         self.learn(&p);
         self.history = vec![p.clone()];
-        p
+        Ok(p)
     }
 
     /// Loads the images of the next frame (pyramids, lighting gain) without searching.
-    pub fn set_frame(&mut self, images: &[RgbImage]) {
+    pub fn set_frame(&mut self, images: &[RgbImage]) -> Result<(), TrackError> {
+        self.check_images(images)?;
         self.views.set_frame(images);
+        Ok(())
+    }
+
+    /// Checks that there is one image per camera, each of its camera's size.
+    fn check_images(&self, images: &[RgbImage]) -> Result<(), TrackError> {
+        let views = &self.views.views;
+        if images.len() != views.len() {
+            return Err(TrackError::Invalid(format!(
+                "{} images for {} cameras",
+                images.len(),
+                views.len()
+            )));
+        }
+        for (c, (img, v)) in images.iter().zip(views).enumerate() {
+            let (w, h) = (v[0].background.width, v[0].background.height);
+            if (img.width() as usize, img.height() as usize) != (w, h) {
+                return Err(TrackError::Invalid(format!(
+                    "image of camera {c} is {}×{}, its camera is {w}×{h}",
+                    img.width(),
+                    img.height()
+                )));
+            }
+        }
+        Ok(())
     }
 
     /// Tracks one frame (after [`start`](Self::start)); returns the pose and its cost.
-    pub fn track(&mut self, images: &[RgbImage]) -> (Vec<f64>, f64) {
+    pub fn track(&mut self, images: &[RgbImage]) -> Result<(Vec<f64>, f64), TrackError> {
+        self.check_images(images)?;
         self.views.set_frame(images);
+        if self.history.is_empty() {
+            self.history.push(self.puppet.rest_params());
+        }
         let n = self.history.len();
         let mut predicted = self.history[n - 1].clone();
         if n >= 2 {
@@ -434,7 +475,7 @@ impl Tracker {
         if self.history.len() > 2 {
             self.history.remove(0);
         }
-        (params, cost)
+        Ok((params, cost))
     }
 
     /// The tracking joints of pose `params`.
@@ -564,7 +605,7 @@ pub fn track_sequence(
         let t0 = Instant::now();
         let images = seq.frame_images(k)?;
         result.io_seconds += t0.elapsed().as_secs_f64();
-        let (params, cost) = tracker.track(&images);
+        let (params, cost) = tracker.track(&images)?;
         result.joints.push(tracker.joints(&params));
         result.params.push(params);
         result.costs.push(cost);
