@@ -84,25 +84,35 @@ fn punch_is_tracked_without_losing_it() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-#[test]
-fn a_sequence_without_cameras_is_a_clear_error() {
-    let dir = temp("nocam");
-    let seq = dir.join("seq");
+/// Makes a one-frame sequence in `seq` with the script.
+fn one_frame_sequence(seq: &std::path::Path) {
     run_file(
         &root().join("scripts/make_sequence.rhai"),
         &sets(&[("out", seq.to_str().unwrap()), ("frames", "1")]),
     )
     .unwrap();
-    std::fs::remove_file(seq.join("cameras/cam2.json")).unwrap();
-    let e = run_file(
+}
+
+/// Runs the tracking script on `seq`, which must fail; returns its error text.
+fn tracking_error(seq: &std::path::Path, out: &std::path::Path) -> String {
+    run_file(
         &root().join("scripts/track_body.rhai"),
         &sets(&[
             ("seq", seq.to_str().unwrap()),
-            ("out", dir.join("t").to_str().unwrap()),
+            ("out", out.to_str().unwrap()),
         ]),
     )
     .unwrap_err()
-    .to_string();
+    .to_string()
+}
+
+#[test]
+fn a_sequence_without_cameras_is_a_clear_error() {
+    let dir = temp("nocam");
+    let seq = dir.join("seq");
+    one_frame_sequence(&seq);
+    std::fs::remove_file(seq.join("cameras/cam2.json")).unwrap();
+    let e = tracking_error(&seq, &dir.join("t"));
     assert!(e.contains("cam2.json"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -139,23 +149,11 @@ fn a_bvh_with_unknown_joints_is_a_clear_error() {
 fn an_image_of_the_wrong_size_is_a_clear_error() {
     let dir = temp("size");
     let seq = dir.join("seq");
-    run_file(
-        &root().join("scripts/make_sequence.rhai"),
-        &sets(&[("out", seq.to_str().unwrap()), ("frames", "1")]),
-    )
-    .unwrap();
+    one_frame_sequence(&seq);
     image::RgbImage::new(100, 50)
         .save(seq.join("backgrounds/cam1.png"))
         .unwrap();
-    let e = run_file(
-        &root().join("scripts/track_body.rhai"),
-        &sets(&[
-            ("seq", seq.to_str().unwrap()),
-            ("out", dir.join("t").to_str().unwrap()),
-        ]),
-    )
-    .unwrap_err()
-    .to_string();
+    let e = tracking_error(&seq, &dir.join("t"));
     assert!(e.contains("cam1.png") && e.contains("100"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
