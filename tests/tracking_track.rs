@@ -172,7 +172,7 @@ fn the_tracker_refuses_images_that_do_not_fit_its_cameras() {
     let e = Tracker::new(
         &mannequin,
         &cameras,
-        &[plate.clone()],
+        std::slice::from_ref(&plate),
         TrackerOptions::default(),
     )
     .err()
