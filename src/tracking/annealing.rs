@@ -203,33 +203,28 @@ mod tests {
             levels: vec![0; 10],
             ..Default::default()
         };
-        let mut rng = SplitMix64::new(1);
         let mut scratch = AnnealScratch::default();
-        let r = anneal(
-            &[0.0, 0.0, 0.0],
-            &[0, 1, 2],
-            &[0.5, 0.5, 0.5],
-            &settings,
-            &mut rng,
-            |_| {},
-            cost,
-            &mut scratch,
-        );
+        let mut run = |seed: u64| {
+            let mut rng = SplitMix64::new(seed);
+            let start = [0.0, 0.0, 0.0];
+            let (dofs, sigma) = ([0, 1, 2], [0.5, 0.5, 0.5]);
+            anneal(
+                &start,
+                &dofs,
+                &sigma,
+                &settings,
+                &mut rng,
+                |_| {},
+                cost,
+                &mut scratch,
+            )
+        };
+        let r = run(1);
         for (a, b) in r.params.iter().zip(&target) {
             assert!((a - b).abs() < 0.08, "{:?}", r.params);
         }
         // bit-identical on a second run with the same seed
-        let mut rng = SplitMix64::new(1);
-        let r2 = anneal(
-            &[0.0, 0.0, 0.0],
-            &[0, 1, 2],
-            &[0.5, 0.5, 0.5],
-            &settings,
-            &mut rng,
-            |_| {},
-            cost,
-            &mut scratch,
-        );
+        let r2 = run(1);
         assert_eq!(r.params, r2.params);
         assert_eq!(r.evaluations, 600);
     }

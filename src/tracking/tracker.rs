@@ -293,7 +293,7 @@ impl Tracker {
         };
         let mut params = start.to_vec();
         let mut cost = f64::INFINITY;
-        let infos = self.puppet.params().to_vec();
+        let infos = self.puppet.params();
         for (s, stage) in STAGES.iter().enumerate() {
             let t0 = Instant::now();
             let dofs: Vec<usize> = (0..infos.len())
@@ -312,10 +312,7 @@ impl Tracker {
             } else {
                 self.options.particles
             };
-            let sigma: Vec<f64> = dofs
-                .iter()
-                .map(|&k| sigma_scale * move_sigma(k, infos[k].group))
-                .collect();
+            let sigma: Vec<f64> = spread.iter().map(|s| sigma_scale * s).collect();
             let app = Appearance {
                 puppet: &self.puppet,
                 mesh: &self.mesh,
