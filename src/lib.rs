@@ -13,6 +13,7 @@ pub mod body;
 pub mod cloth;
 pub mod contact;
 pub mod facade;
+pub mod face;
 pub mod garment;
 pub mod geometry;
 pub mod kes;
