@@ -5,12 +5,31 @@
 //! - [`error`]: the module's error type;
 //! - [`model`]: the generic face mesh (MediaPipe canonical mesh, metres) and its measures;
 //! - [`landmarks`]: the 68-point iBUG landmark scheme mapped onto the mesh, `.pts` files;
-//! - [`render`]: textured, z-buffered rendering of a face mesh through a camera.
+//! - [`render`]: textured, z-buffered rendering of a face mesh through a camera;
+//! - [`candide`], [`fap`], [`muscles`], [`expressions`], [`blendshapes`]: animation — the
+//!   CANDIDE-3 model, MPEG-4 FAPs on the mesh, Bézier muscles, named sliders, ARKit-52 export;
+//! - [`regions`], [`rbf`], [`contour`], [`view_fit`], [`adapt`]: adaptation of the generic mesh
+//!   to a person's photos;
+//! - [`texture_bake`], [`export`], [`error_map`]: texture from photos, OBJ+MTL and glTF files,
+//!   the signed error map between two surfaces.
 
+pub mod adapt;
+pub mod blendshapes;
+pub mod candide;
+pub mod contour;
 pub mod error;
+pub mod error_map;
+pub mod export;
+pub mod expressions;
+pub mod fap;
 pub mod landmarks;
 pub mod model;
+pub mod muscles;
+pub mod rbf;
+pub mod regions;
 pub mod render;
+pub mod texture_bake;
+pub mod view_fit;
 
 pub use error::FaceError;
 pub use model::FaceMesh;
