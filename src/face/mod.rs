@@ -11,7 +11,10 @@
 //! - [`regions`], [`rbf`], [`contour`], [`view_fit`], [`adapt`]: adaptation of the generic mesh
 //!   to a person's photos;
 //! - [`texture_bake`], [`export`], [`error_map`]: texture from photos, OBJ+MTL and glTF files,
-//!   the signed error map between two surfaces.
+//!   the signed error map between two surfaces;
+//! - [`head_pose`], [`skin`], [`sequence`], [`sequence_files`]: synthetic sequences with ground
+//!   truth (pose and FAP trajectories) and reading sequence folders;
+//! - [`gray`], [`samples`], [`tracker`]: tracking of head pose and expression.
 
 pub mod adapt;
 pub mod blendshapes;
@@ -22,13 +25,20 @@ pub mod error_map;
 pub mod export;
 pub mod expressions;
 pub mod fap;
+pub mod gray;
+pub mod head_pose;
 pub mod landmarks;
 pub mod model;
 pub mod muscles;
 pub mod rbf;
 pub mod regions;
 pub mod render;
+pub mod samples;
+pub mod sequence;
+pub mod sequence_files;
+pub mod skin;
 pub mod texture_bake;
+pub mod tracker;
 pub mod view_fit;
 
 pub use error::FaceError;

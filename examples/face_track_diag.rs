@@ -1,0 +1,64 @@
+//! Diagnostics of the face tracker on a synthetic sequence: per-frame pose and FAP errors.
+//! `cargo run --release --example face_track_diag -- OUT_DIR [frames] [rigid]`
+
+use emilion::face::sequence::{make_face_sequence, FaceSequenceOptions};
+use emilion::face::sequence_files::FaceSequence;
+use emilion::face::tracker::{FaceTracker, FaceTrackerOptions};
+use std::path::Path;
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let out = Path::new(args.get(1).map(String::as_str).unwrap_or("/tmp/face_diag"));
+    let frames: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(20);
+    let rigid = args.get(3).is_some_and(|s| s == "rigid");
+    let mut o = FaceSequenceOptions {
+        frames,
+        ..Default::default()
+    };
+    if rigid {
+        o.faps.clear();
+    }
+    let t = std::time::Instant::now();
+    make_face_sequence(out, &o).unwrap();
+    eprintln!("sequence {:.2} s", t.elapsed().as_secs_f64());
+    let seq = FaceSequence::open(out).unwrap();
+    let truth = seq.truth.clone().unwrap();
+    let mut tr = FaceTracker::new(
+        &seq.model,
+        &seq.cameras,
+        &seq.info.faps,
+        seq.init.pose,
+        &seq.init.faps,
+        &FaceTrackerOptions::default(),
+    )
+    .unwrap();
+    eprintln!("samples {}", tr.sample_count());
+    let t = std::time::Instant::now();
+    let mut sum = 0.0;
+    for k in 0..seq.info.frames {
+        let imgs = seq.frame_images(k).unwrap();
+        let r = tr.track(&imgs).unwrap();
+        let e = r.pose.angle_to(&truth[k].pose).to_degrees();
+        let te = (r.pose.translation - truth[k].pose.translation).norm() * 1000.0;
+        let fe: Vec<String> = r
+            .faps
+            .iter()
+            .zip(&truth[k].faps)
+            .zip(&seq.info.fap_ranges)
+            .map(|((a, b), (lo, hi))| format!("{:.0}", 100.0 * (a - b).abs() / (hi - lo)))
+            .collect();
+        sum += e;
+        println!(
+            "{k:3} rot {e:.2}° t {te:.1} mm cost {:.3} faps% {}",
+            r.cost,
+            fe.join(" ")
+        );
+    }
+    let dt = t.elapsed().as_secs_f64();
+    println!(
+        "mean rot {:.2}°, {:.1} fps, seen {:.2}",
+        sum / seq.info.frames as f64,
+        seq.info.frames as f64 / dt,
+        tr.seen_fraction()
+    );
+}

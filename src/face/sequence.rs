@@ -1,0 +1,398 @@
+//! Synthetic face sequences with ground truth: the textured model with known shape, head pose
+//! and expression trajectories (MPEG-4 FAP curves), rendered from several cameras over real
+//! photos, with lighting change and sensor noise.
+//!
+//! Layout of a sequence folder (all written by [`make_face_sequence`], read by
+//! [`FaceSequence::open`](super::sequence_files::FaceSequence::open)):
+//! - `sequence.json`: frame count, frame rate, image size, camera names, the FAP numbers with
+//!   their names and ranges, and the settings used;
+//! - `cameras/camN.json`: the cameras (the project's camera format);
+//! - `images/camN/NNNN.png`: the frames;
+//! - `model.obj`: the neutral face (metres, with texture coordinates) — the "adapted model"
+//!   a tracker starts from;
+//! - `init.csv`: pose and FAP values of frame 0 (the pre-positioning);
+//! - `ground_truth.csv`: pose and FAP values of every frame (columns `frame`, `time`,
+//!   `yaw_deg`, `pitch_deg`, `roll_deg`, `tx`, `ty`, `tz` (m), then `fap_N` in FAP units);
+//! - `truth/texture.png`: the texture used (not needed by a tracker).
+//!
+//! Trajectories: yaw ±`yaw_deg`, pitch ±½·`yaw_deg`, roll ±⅓·`yaw_deg` and a translation of
+//! ±1.5 cm, as sums of slow sines; each FAP moves between its range's ends as a raised cosine
+//! of its own frequency (0.3–0.9 Hz) and phase, so expressions build up and relax. Lighting:
+//! a global gain of 1 ± `light` per frame (slow), then Gaussian noise of σ = `noise`.
+
+use std::path::Path;
+
+use image::RgbImage;
+use serde::{Deserialize, Serialize};
+
+use super::fap::FapRig;
+use super::head_pose::{head_pivot, HeadPose};
+use super::model::{data_dir, FaceMesh};
+use super::render::{FaceRenderer, Texture};
+use super::sequence_files::{write_pose_csv, PoseRow, SequenceInfo};
+use super::skin::procedural_face_texture;
+use super::FaceError;
+use crate::geometry::{write_obj, SplitMix64, Vec3};
+use crate::tracking::camera::Camera;
+use nalgebra::Matrix3;
+
+/// FAPs animated by default (until the rig names its tracked set).
+pub const DEFAULT_FAPS: [u8; 9] = [3, 12, 13, 6, 7, 31, 32, 19, 20];
+
+/// Settings of [`make_face_sequence`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct FaceSequenceOptions {
+    /// Number of frames (1..=10000). Default 50.
+    pub frames: usize,
+    /// Frame rate (Hz). Default 25.
+    pub fps: f64,
+    /// Image width (pixels). Default 640.
+    pub width: u32,
+    /// Image height (pixels). Default 480.
+    pub height: u32,
+    /// Number of cameras (1..=8), spread over ±30° of yaw around the face. Default 3.
+    pub cameras: usize,
+    /// Distance of the cameras from the head pivot (m). Default 0.6.
+    pub distance: f64,
+    /// Focal length (pixels). Default 1000.
+    pub focal: f64,
+    /// Amplitude of the yaw (degrees); pitch and roll are half and a third. Default 20.
+    pub yaw_deg: f64,
+    /// FAPs animated (MPEG-4 numbers; each must be in the rig). Default: the tracked set.
+    pub faps: Vec<u8>,
+    /// Sensor noise σ (grey levels). Default 2.
+    pub noise: f64,
+    /// Lighting change: the gain varies in `1 ± light`. Default 0.04.
+    pub light: f64,
+    /// Texture size (texels). Default 512.
+    pub texture_size: usize,
+    /// A texture image to use instead of the procedural one (for the MediaPipe UV layout).
+    pub texture: Option<String>,
+    /// A neutral model OBJ (metres, MediaPipe vertex order) instead of the canonical face.
+    pub model: Option<String>,
+    /// Folder of background photos (the first is used, cropped per camera); none: grey.
+    pub backgrounds: Option<String>,
+    /// Seed of every random choice.
+    pub seed: u64,
+}
+
+impl Default for FaceSequenceOptions {
+    fn default() -> Self {
+        FaceSequenceOptions {
+            frames: 50,
+            fps: 25.0,
+            width: 640,
+            height: 480,
+            cameras: 3,
+            distance: 0.6,
+            focal: 1000.0,
+            yaw_deg: 20.0,
+            faps: DEFAULT_FAPS.to_vec(),
+            noise: 2.0,
+            light: 0.04,
+            texture_size: 512,
+            texture: None,
+            model: None,
+            backgrounds: Some(
+                data_dir()
+                    .join("facades/labelmefacade/images")
+                    .to_string_lossy()
+                    .into_owned(),
+            ),
+            seed: 1,
+        }
+    }
+}
+
+impl FaceSequenceOptions {
+    /// Checks every setting; the error names the parameter.
+    pub fn validate(&self) -> Result<(), FaceError> {
+        let p = FaceError::parameter;
+        if !(1..=10_000).contains(&self.frames) {
+            return Err(p(
+                "frames",
+                format!("must be 1..=10000, got {}", self.frames),
+            ));
+        }
+        if !(self.fps.is_finite() && self.fps > 0.0) {
+            return Err(p("fps", format!("must be positive, got {}", self.fps)));
+        }
+        if !(32..=8192).contains(&self.width) || !(32..=8192).contains(&self.height) {
+            return Err(p(
+                "width/height",
+                format!("must be 32..=8192, got {}×{}", self.width, self.height),
+            ));
+        }
+        if !(1..=8).contains(&self.cameras) {
+            return Err(p("cameras", format!("must be 1..=8, got {}", self.cameras)));
+        }
+        for (name, v) in [("distance", self.distance), ("focal", self.focal)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(p(name, format!("must be finite and positive, got {v}")));
+            }
+        }
+        for (name, v) in [
+            ("yaw_deg", self.yaw_deg),
+            ("noise", self.noise),
+            ("light", self.light),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(p(name, format!("must be finite and ≥ 0, got {v}")));
+            }
+        }
+        if self.yaw_deg > 60.0 {
+            return Err(p("yaw_deg", format!("at most 60°, got {}", self.yaw_deg)));
+        }
+        if self.light >= 0.5 {
+            return Err(p("light", format!("must be below 0.5, got {}", self.light)));
+        }
+        if !(16..=4096).contains(&self.texture_size) {
+            return Err(p(
+                "texture_size",
+                format!("must be 16..=4096, got {}", self.texture_size),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The cameras of a sequence: `n` cameras at yaw angles spread over ±30° (one camera:
+/// frontal), at `distance` from `pivot`, level with it, looking at it.
+pub fn face_cameras(
+    n: usize,
+    width: u32,
+    height: u32,
+    focal: f64,
+    distance: f64,
+    pivot: Vec3,
+) -> Vec<Camera> {
+    (0..n)
+        .map(|k| {
+            let yaw = if n == 1 {
+                0.0
+            } else {
+                (-30.0 + 60.0 * k as f64 / (n - 1) as f64).to_radians()
+            };
+            let eye = pivot + distance * Vec3::new(yaw.sin(), 0.05, yaw.cos());
+            let f = (pivot - eye).normalize();
+            let right = Vec3::y().cross(&f).normalize();
+            let right = -right; // image x towards the subject's left seen from the front
+            let down = f.cross(&right);
+            let rotation =
+                Matrix3::from_rows(&[right.transpose(), down.transpose(), f.transpose()]);
+            Camera::new(
+                focal,
+                focal,
+                (width as f64 - 1.0) / 2.0,
+                (height as f64 - 1.0) / 2.0,
+                rotation,
+                -(rotation * eye),
+                width,
+                height,
+            )
+        })
+        .collect()
+}
+
+/// Ground-truth pose and FAP values of frame `k` (see the [module docs](self)).
+pub fn trajectory(
+    options: &FaceSequenceOptions,
+    ranges: &[(f64, f64)],
+    k: usize,
+) -> (HeadPose, Vec<f64>) {
+    let t = k as f64 / options.fps;
+    let tau = std::f64::consts::TAU;
+    let mut rng = SplitMix64::new(options.seed.wrapping_mul(0x9E37_79B9) ^ 0xFACE);
+    let mut phase = || rng.range(0.0, tau);
+    let a = options.yaw_deg.to_radians();
+    let (p1, p2, p3, p4, p5, p6) = (phase(), phase(), phase(), phase(), phase(), phase());
+    let yaw = a * (0.8 * (tau * 0.31 * t + p1).sin() + 0.2 * (tau * 0.83 * t + p2).sin());
+    let pitch = 0.5 * a * (tau * 0.47 * t + p3).sin();
+    let roll = a / 3.0 * (tau * 0.37 * t + p4).sin();
+    let tr = Vec3::new(
+        0.015 * (tau * 0.23 * t + p5).sin(),
+        0.01 * (tau * 0.29 * t + p6).sin(),
+        0.015 * (tau * 0.19 * t + p1 + p2).sin(),
+    );
+    let faps = ranges
+        .iter()
+        .enumerate()
+        .map(|(i, &(lo, hi))| {
+            let f = 0.3 + 0.6 * ((i as f64 * 0.618_034) % 1.0);
+            let ph = phase();
+            // rest value: 0 when inside the range, else the nearer end
+            let rest = 0.0f64.clamp(lo, hi);
+            let peak = if (hi - rest).abs() >= (lo - rest).abs() {
+                hi
+            } else {
+                lo
+            };
+            let s = 0.5 - 0.5 * (tau * f * t + ph).cos();
+            rest + (peak - rest) * s
+        })
+        .collect();
+    (HeadPose::from_angles(yaw, pitch, roll, tr), faps)
+}
+
+/// Writes a sequence into `out` (see the [module docs](self)); returns its description.
+pub fn make_face_sequence(
+    out: &Path,
+    options: &FaceSequenceOptions,
+) -> Result<SequenceInfo, FaceError> {
+    options.validate()?;
+    let mesh = match &options.model {
+        Some(m) => FaceMesh::load_obj(Path::new(m), 1.0)?,
+        None => FaceMesh::mediapipe()?,
+    };
+    mesh.validate("model")?;
+    let rig = FapRig::new(&mesh)?;
+    let mut fap_index = Vec::new();
+    for &n in &options.faps {
+        fap_index.push(
+            rig.index_of(n).ok_or_else(|| {
+                FaceError::parameter("faps", format!("FAP {n} is not in the rig"))
+            })?,
+        );
+    }
+    let ranges: Vec<(f64, f64)> = fap_index.iter().map(|&i| rig.faps[i].range).collect();
+    let texture = match &options.texture {
+        Some(t) => Texture::load(Path::new(t))?,
+        None => procedural_face_texture(&mesh, options.texture_size, options.seed),
+    };
+    let pivot = head_pivot(&mesh);
+    let cameras = face_cameras(
+        options.cameras,
+        options.width,
+        options.height,
+        options.focal,
+        options.distance,
+        pivot,
+    );
+    let mut rng = SplitMix64::new(options.seed ^ 0xBAC6_0D);
+    let backgrounds = backgrounds(options, &mut rng)?;
+
+    let mkdir = |p: &Path| std::fs::create_dir_all(p).map_err(|e| FaceError::io(p, e));
+    mkdir(&out.join("cameras"))?;
+    mkdir(&out.join("truth"))?;
+    let names: Vec<String> = (0..cameras.len()).map(|k| format!("cam{k}")).collect();
+    for (cam, name) in cameras.iter().zip(&names) {
+        mkdir(&out.join("images").join(name))?;
+        let path = out.join("cameras").join(format!("{name}.json"));
+        cam.save(&path).map_err(|e| FaceError::io(&path, e))?;
+    }
+    let model_path = out.join("model.obj");
+    let tris: Vec<[usize; 3]> = mesh
+        .triangles
+        .iter()
+        .map(|t| t.map(|i| i as usize))
+        .collect();
+    write_obj(&model_path, &mesh.positions, &tris, Some(&mesh.uvs))
+        .map_err(|e| FaceError::io(&model_path, e))?;
+    texture.save(&out.join("truth").join("texture.png"))?;
+
+    let mut rows = Vec::with_capacity(options.frames);
+    let mut renderer = FaceRenderer::new(options.width as usize, options.height as usize);
+    let mut values = vec![0.0; rig.len()];
+    let (mut deformed, mut posed) = (Vec::new(), Vec::new());
+    let mut light_rng = SplitMix64::new(options.seed ^ 0x11_6470);
+    let lp = [light_rng.range(0.0, 6.3), light_rng.range(0.0, 6.3)];
+    for k in 0..options.frames {
+        let (pose, faps) = trajectory(options, &ranges, k);
+        values.iter_mut().for_each(|v| *v = 0.0);
+        for (&i, &v) in fap_index.iter().zip(&faps) {
+            values[i] = v;
+        }
+        rig.apply(&mesh.positions, &values, &mut deformed);
+        pose.apply(&pivot, &deformed, &mut posed);
+        let t = k as f64 / options.fps;
+        let gain =
+            1.0 + options.light * (0.7 * (1.3 * t + lp[0]).sin() + 0.3 * (3.1 * t + lp[1]).sin());
+        for (c, cam) in cameras.iter().enumerate() {
+            renderer.render(cam, &posed, &mesh.uvs, &mesh.triangles, &texture);
+            let mut img = renderer.composite(&backgrounds[c])?;
+            let mut noise = SplitMix64::new(options.seed ^ ((k as u64) << 8) ^ c as u64 ^ 0x0153);
+            for p in img.pixels_mut() {
+                for ch in p.0.iter_mut() {
+                    let v = *ch as f64 * gain + options.noise * noise.normal();
+                    *ch = v.round().clamp(0.0, 255.0) as u8;
+                }
+            }
+            let path = out
+                .join("images")
+                .join(&names[c])
+                .join(format!("{k:04}.png"));
+            img.save(&path).map_err(|e| FaceError::io(&path, e))?;
+        }
+        rows.push(PoseRow {
+            frame: k,
+            time: t,
+            pose,
+            faps,
+        });
+    }
+    write_pose_csv(&out.join("ground_truth.csv"), &options.faps, &rows)?;
+    write_pose_csv(&out.join("init.csv"), &options.faps, &rows[..1])?;
+    let info = SequenceInfo {
+        frames: options.frames,
+        fps: options.fps,
+        width: options.width,
+        height: options.height,
+        cameras: names,
+        faps: options.faps.clone(),
+        fap_names: fap_index
+            .iter()
+            .map(|&i| rig.faps[i].name.clone())
+            .collect(),
+        fap_ranges: ranges,
+        options: Some(options.clone()),
+    };
+    info.save(&out.join("sequence.json"))?;
+    Ok(info)
+}
+
+/// One background per camera: the first photo of the folder cropped at a seeded place, or grey.
+fn backgrounds(
+    options: &FaceSequenceOptions,
+    rng: &mut SplitMix64,
+) -> Result<Vec<RgbImage>, FaceError> {
+    let (w, h) = (options.width, options.height);
+    let grey = || RgbImage::from_pixel(w, h, image::Rgb([110, 115, 120]));
+    let Some(dir) = &options.backgrounds else {
+        return Ok(vec![grey(); options.cameras]);
+    };
+    let dir = Path::new(dir);
+    let mut photos: Vec<_> = std::fs::read_dir(dir)
+        .map_err(|e| FaceError::io(dir, e))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.extension()
+                .and_then(|e| e.to_str())
+                .is_some_and(|e| matches!(e.to_ascii_lowercase().as_str(), "jpg" | "jpeg" | "png"))
+        })
+        .collect();
+    photos.sort();
+    if photos.is_empty() {
+        return Err(FaceError::io(
+            dir,
+            "no background photos (*.jpg, *.png) in the folder",
+        ));
+    }
+    (0..options.cameras)
+        .map(|c| {
+            let path = &photos[(options.seed as usize + c) % photos.len()];
+            let img = image::open(path)
+                .map_err(|e| FaceError::io(path, e))?
+                .into_rgb8();
+            let s = (w as f64 / img.width() as f64).max(h as f64 / img.height() as f64);
+            let (nw, nh) = (
+                ((img.width() as f64 * s).ceil() as u32).max(w),
+                ((img.height() as f64 * s).ceil() as u32).max(h),
+            );
+            let big = image::imageops::resize(&img, nw, nh, image::imageops::FilterType::Triangle);
+            let ox = rng.below((nw - w + 1) as usize) as u32;
+            let oy = rng.below((nh - h + 1) as usize) as u32;
+            Ok(image::imageops::crop_imm(&big, ox, oy, w, h).to_image())
+        })
+        .collect()
+}
