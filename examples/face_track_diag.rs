@@ -48,6 +48,28 @@ fn main() {
             .map(|((a, b), (lo, hi))| format!("{:.0}", 100.0 * (a - b).abs() / (hi - lo)))
             .collect();
         sum += e;
+        if let Ok(j) = std::env::var("PROFILE") {
+            let j: usize = j.parse().unwrap();
+            let (lo, hi) = seq.info.fap_ranges[j];
+            let mut f = truth[k].faps.clone();
+            let mut line = String::new();
+            for s in 0..=8 {
+                f[j] = lo + (hi - lo) * s as f64 / 8.0;
+                line.push_str(&format!(
+                    " {:.0}:{:.1}",
+                    f[j],
+                    tr.cost_at(&truth[k].pose, &f, 0)
+                ));
+            }
+            println!("    profile fap {j} true {:.0}:{line}", truth[k].faps[j]);
+        }
+        if std::env::var("FAPDUMP").is_ok() {
+            println!(
+                "    est {:?}\n    tru {:?}",
+                r.faps.iter().map(|v| v.round()).collect::<Vec<_>>(),
+                truth[k].faps.iter().map(|v| v.round()).collect::<Vec<_>>()
+            );
+        }
         println!(
             "{k:3} rot {e:.2}° t {te:.1} mm cost {:.3} faps% {}",
             r.cost,

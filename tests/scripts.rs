@@ -96,7 +96,8 @@ fn other_scripts_run() {
         let name = p.file_stem().unwrap().to_str().unwrap().to_string();
         // the contact scripts run in tests/contact_scripts.rs, the garments in
         // tests/garment_scripts.rs, buckle_square in tests/buckling.rs and the tracking
-        // scripts in tests/tracking_track.rs, with their checks
+        // scripts in tests/tracking_track.rs, the face scripts in tests/face_track.rs,
+        // with their checks
         if [
             "hang",
             "drop",
@@ -113,6 +114,8 @@ fn other_scripts_run() {
             "buckle_cylinder",
             "make_sequence",
             "track_body",
+            "make_face_sequence",
+            "face_track",
         ]
         .contains(&name.as_str())
         {

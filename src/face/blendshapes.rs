@@ -1,1 +1,364 @@
-//! (being written)
+//! Export of the 52 ARKit blendshapes, the de-facto interchange set of face rigs (Blender,
+//! Unity, Unreal, three.js): each shape defined on the face mesh as a combination of FAPs and
+//! muscles ([`crate::face::expressions::Slider`]), written as a binary glTF (`.glb`) whose
+//! mesh has one morph target per shape, named through `mesh.extras.targetNames` (the
+//! convention Blender and three.js read), plus a CSV summary.
+//!
+//! Names and order are Apple's (`ARFaceAnchor.BlendShapeLocation`, grouped as documented:
+//! left eye, right eye, mouth and jaw, eyebrows, cheeks, nose, tongue). `Left` is the
+//! subject's left (+x on the MediaPipe mesh). Shapes the mesh cannot represent are zero
+//! displacement fields: the eye-gaze shapes `eyeLook{Down,In,Out,Up}{Left,Right}` (the
+//! canonical mesh has no eyeballs) and `tongueOut` (no tongue).
+
+use std::io::Write;
+use std::path::Path;
+
+use gltf_json::accessor::{ComponentType, Type};
+use gltf_json::buffer::Target;
+use gltf_json::mesh::{Mode, MorphTarget, Primitive, Semantic};
+use gltf_json::validation::Checked::Valid;
+use gltf_json::{Accessor, Mesh, Node, Scene};
+
+use super::expressions::{combination, Slider};
+use super::fap::FapRig;
+use super::model::FaceMesh;
+use super::muscles::MuscleRig;
+use super::FaceError;
+use crate::geometry::gltf::{f32_bounds, glb_accessor, glb_root, glb_view};
+use crate::geometry::Vec3;
+
+/// The 52 ARKit blendshape names, in Apple's documented order.
+pub const ARKIT_NAMES: [&str; 52] = [
+    "eyeBlinkLeft",
+    "eyeLookDownLeft",
+    "eyeLookInLeft",
+    "eyeLookOutLeft",
+    "eyeLookUpLeft",
+    "eyeSquintLeft",
+    "eyeWideLeft",
+    "eyeBlinkRight",
+    "eyeLookDownRight",
+    "eyeLookInRight",
+    "eyeLookOutRight",
+    "eyeLookUpRight",
+    "eyeSquintRight",
+    "eyeWideRight",
+    "jawForward",
+    "jawLeft",
+    "jawRight",
+    "jawOpen",
+    "mouthClose",
+    "mouthFunnel",
+    "mouthPucker",
+    "mouthLeft",
+    "mouthRight",
+    "mouthSmileLeft",
+    "mouthSmileRight",
+    "mouthFrownLeft",
+    "mouthFrownRight",
+    "mouthDimpleLeft",
+    "mouthDimpleRight",
+    "mouthStretchLeft",
+    "mouthStretchRight",
+    "mouthRollLower",
+    "mouthRollUpper",
+    "mouthShrugLower",
+    "mouthShrugUpper",
+    "mouthPressLeft",
+    "mouthPressRight",
+    "mouthLowerDownLeft",
+    "mouthLowerDownRight",
+    "mouthUpperUpLeft",
+    "mouthUpperUpRight",
+    "browDownLeft",
+    "browDownRight",
+    "browInnerUp",
+    "browOuterUpLeft",
+    "browOuterUpRight",
+    "cheekPuff",
+    "cheekSquintLeft",
+    "cheekSquintRight",
+    "noseSneerLeft",
+    "noseSneerRight",
+    "tongueOut",
+];
+
+/// Definition of one ARKit shape at weight 1: FAPs as fractions of their range, muscles as
+/// activations. Empty for the shapes the mesh cannot represent (see the module docs).
+pub fn arkit_definition(name: &str) -> Option<Slider> {
+    let f: &[(u8, f64)] = match name {
+        "eyeBlinkLeft" => &[(19, 1.0)],
+        "eyeBlinkRight" => &[(20, 1.0)],
+        "eyeSquintLeft" => &[(21, 0.4), (19, 0.15), (41, 0.3)],
+        "eyeSquintRight" => &[(22, 0.4), (20, 0.15), (42, 0.3)],
+        "eyeWideLeft" => &[(19, -1.0)],
+        "eyeWideRight" => &[(20, -1.0)],
+        "jawForward" => &[(14, 1.0)],
+        "jawLeft" => &[(15, -1.0)],
+        "jawRight" => &[(15, 1.0)],
+        "jawOpen" => &[(3, 1.0)],
+        "mouthClose" => &[(4, 1.0), (5, 1.0)],
+        "mouthFunnel" => &[(16, 0.6), (17, 0.6), (4, -0.4), (5, -0.4)],
+        "mouthPucker" => &[(16, 1.0), (17, 1.0), (6, -0.5), (7, -0.5)],
+        "mouthLeft" => &[(6, 0.6), (7, -0.6)],
+        "mouthRight" => &[(6, -0.6), (7, 0.6)],
+        "mouthSmileLeft" => &[(12, 0.4), (6, 0.2)],
+        "mouthSmileRight" => &[(13, 0.4), (7, 0.2)],
+        "mouthFrownLeft" => &[(12, -0.3)],
+        "mouthFrownRight" => &[(13, -0.3)],
+        "mouthDimpleLeft" => &[(6, 0.5)],
+        "mouthDimpleRight" => &[(7, 0.5)],
+        "mouthStretchLeft" => &[(6, 0.8), (12, -0.3)],
+        "mouthStretchRight" => &[(7, 0.8), (13, -0.3)],
+        "mouthRollLower" => &[(5, 0.5), (16, -0.6)],
+        "mouthRollUpper" => &[(4, 0.5), (17, -0.6)],
+        "mouthShrugLower" => &[(5, 0.7), (16, 0.4)],
+        "mouthShrugUpper" => &[(4, -0.5), (17, 0.3)],
+        "mouthPressLeft" => &[(8, 0.4), (10, 0.4)],
+        "mouthPressRight" => &[(9, 0.4), (11, 0.4)],
+        "mouthLowerDownLeft" => &[(10, -1.0)],
+        "mouthLowerDownRight" => &[(11, -1.0)],
+        "mouthUpperUpLeft" => &[(8, -1.0)],
+        "mouthUpperUpRight" => &[(9, -1.0)],
+        "browDownLeft" => &[(31, -0.8), (33, -0.8), (35, -0.8), (37, 0.5)],
+        "browDownRight" => &[(32, -0.8), (34, -0.8), (36, -0.8), (38, 0.5)],
+        "browInnerUp" => &[(31, 1.0), (32, 1.0)],
+        "browOuterUpLeft" => &[(35, 1.0)],
+        "browOuterUpRight" => &[(36, 1.0)],
+        "cheekPuff" => &[(39, 1.0), (40, 1.0)],
+        "cheekSquintLeft" => &[(41, 1.0)],
+        "cheekSquintRight" => &[(42, 1.0)],
+        "noseSneerLeft" => &[(61, 0.6), (63, 0.3), (8, -0.3)],
+        "noseSneerRight" => &[(62, 0.6), (63, 0.3), (9, -0.3)],
+        n if ARKIT_NAMES.contains(&n) => &[],
+        _ => return None,
+    };
+    let m: &[(&str, f64)] = match name {
+        "mouthSmileLeft" => &[("zygomatic_major_l", 1.0)],
+        "mouthSmileRight" => &[("zygomatic_major_r", 1.0)],
+        "mouthFrownLeft" => &[("depressor_anguli_oris_l", 1.0)],
+        "mouthFrownRight" => &[("depressor_anguli_oris_r", 1.0)],
+        "mouthFunnel" => &[("orbicularis_upper", 0.5), ("orbicularis_lower", 0.5)],
+        "mouthPucker" => &[("orbicularis_upper", 1.0), ("orbicularis_lower", 1.0)],
+        "browDownLeft" => &[("corrugator_l", 0.5)],
+        "browDownRight" => &[("corrugator_r", 0.5)],
+        "noseSneerLeft" => &[("levator_labii_l", 0.7)],
+        "noseSneerRight" => &[("levator_labii_r", 0.7)],
+        _ => &[],
+    };
+    Some(Slider::new(name, (0.0, 1.0), f, m))
+}
+
+/// The 52 shapes as dense displacement fields (m) on a mesh of `n` vertices, in
+/// [`ARKIT_NAMES`] order.
+pub fn arkit_displacements(
+    faps: &FapRig,
+    muscles: &MuscleRig,
+    n: usize,
+) -> Result<Vec<(String, Vec<Vec3>)>, FaceError> {
+    ARKIT_NAMES
+        .iter()
+        .map(|&name| {
+            let s = arkit_definition(name)
+                .ok_or_else(|| FaceError::Failed(format!("no definition for `{name}`")))?;
+            Ok((
+                name.to_string(),
+                combination(faps, muscles, n, &s.faps, &s.muscles)?,
+            ))
+        })
+        .collect()
+}
+
+/// Writes `mesh` (its positions as the neutral face) as binary glTF with the 52 ARKit morph
+/// targets of the rigs, and next to it `<stem>.csv`: `name,max_displacement_m,vertex` per
+/// shape. The glTF mesh has `POSITION`, `NORMAL`, `TEXCOORD_0` (v flipped to glTF's top-left
+/// origin), `u32` indices, 52 `POSITION` morph targets, zero default weights and
+/// `extras.targetNames`. Files are written to a temporary name and renamed. Errors name the
+/// file.
+pub fn write_arkit_glb(
+    path: &Path,
+    mesh: &FaceMesh,
+    faps: &FapRig,
+    muscles: &MuscleRig,
+) -> Result<(), FaceError> {
+    let n = mesh.positions.len();
+    let fail = |m: String| FaceError::Failed(format!("{}: {m}", path.display()));
+    mesh.validate(&path.display().to_string())?;
+    if n == 0 || mesh.triangles.is_empty() {
+        return Err(fail("nothing to write: empty mesh".into()));
+    }
+    let shapes = arkit_displacements(faps, muscles, n)?;
+    let f32s = |v: &[Vec3]| -> Vec<[f32; 3]> {
+        v.iter()
+            .map(|p| [p.x as f32, p.y as f32, p.z as f32])
+            .collect()
+    };
+    let pos = f32s(&mesh.positions);
+    let (lo, hi) = f32_bounds(&pos).map_err(fail)?;
+    let normals: Vec<[f32; 3]> = mesh
+        .vertex_normals()
+        .iter()
+        .map(|v| {
+            if v.norm() > 0.5 {
+                [v.x as f32, v.y as f32, v.z as f32]
+            } else {
+                [0.0, 0.0, 1.0]
+            }
+        })
+        .collect();
+    let mut bin: Vec<u8> = Vec::new();
+    let put3 = |bin: &mut Vec<u8>, data: &[[f32; 3]]| {
+        let at = bin.len() as u64;
+        data.iter()
+            .flatten()
+            .for_each(|c| bin.extend_from_slice(&c.to_le_bytes()));
+        at
+    };
+    let pos_at = put3(&mut bin, &pos);
+    let nrm_at = put3(&mut bin, &normals);
+    let mut target_at = Vec::with_capacity(shapes.len());
+    for (_, d) in &shapes {
+        let d32 = f32s(d);
+        let bounds = f32_bounds(&d32).map_err(fail)?;
+        target_at.push((put3(&mut bin, &d32), bounds));
+    }
+    let uv_at = bin.len() as u64;
+    for uv in &mesh.uvs {
+        bin.extend_from_slice(&(uv[0] as f32).to_le_bytes());
+        bin.extend_from_slice(&((1.0 - uv[1]) as f32).to_le_bytes());
+    }
+    let idx_at = bin.len() as u64;
+    for t in &mesh.triangles {
+        t.iter()
+            .for_each(|i| bin.extend_from_slice(&i.to_le_bytes()));
+    }
+    let (len3, nu) = (12 * n as u64, n as u64);
+    let (mut root, buffer) = glb_root(bin.len());
+    let attr = |root: &mut gltf_json::Root, at: u64, len: u64, ty: Type, target: Target| {
+        let view = root.push(glb_view(buffer, at, len, Some(target)));
+        glb_accessor(
+            view,
+            if ty == Type::Vec2 { nu } else { len / 12 },
+            ComponentType::F32,
+            ty,
+        )
+    };
+    let pos_acc = attr(&mut root, pos_at, len3, Type::Vec3, Target::ArrayBuffer);
+    let pos_acc = root.push(Accessor {
+        min: Some(serde_json::json!(lo)),
+        max: Some(serde_json::json!(hi)),
+        ..pos_acc
+    });
+    let nrm_acc = attr(&mut root, nrm_at, len3, Type::Vec3, Target::ArrayBuffer);
+    let nrm_acc = root.push(nrm_acc);
+    let uv_acc = attr(&mut root, uv_at, 8 * nu, Type::Vec2, Target::ArrayBuffer);
+    let uv_acc = root.push(uv_acc);
+    let mut targets = Vec::with_capacity(shapes.len());
+    for &(at, (tlo, thi)) in &target_at {
+        let acc = attr(&mut root, at, len3, Type::Vec3, Target::ArrayBuffer);
+        let acc = root.push(Accessor {
+            min: Some(serde_json::json!(tlo)),
+            max: Some(serde_json::json!(thi)),
+            ..acc
+        });
+        targets.push(MorphTarget {
+            positions: Some(acc),
+            normals: None,
+            tangents: None,
+        });
+    }
+    let idx_view = root.push(glb_view(
+        buffer,
+        idx_at,
+        12 * mesh.triangles.len() as u64,
+        Some(Target::ElementArrayBuffer),
+    ));
+    let idx_acc = root.push(glb_accessor(
+        idx_view,
+        3 * mesh.triangles.len() as u64,
+        ComponentType::U32,
+        Type::Scalar,
+    ));
+    let primitive = Primitive {
+        attributes: [
+            (Valid(Semantic::Positions), pos_acc),
+            (Valid(Semantic::Normals), nrm_acc),
+            (Valid(Semantic::TexCoords(0)), uv_acc),
+        ]
+        .into_iter()
+        .collect(),
+        extensions: None,
+        extras: Default::default(),
+        indices: Some(idx_acc),
+        material: None,
+        mode: Valid(Mode::Triangles),
+        targets: Some(targets),
+    };
+    let gmesh = root.push(Mesh {
+        extensions: None,
+        extras: Default::default(),
+        primitives: vec![primitive],
+        weights: Some(vec![0.0; shapes.len()]),
+    });
+    let node = root.push(Node {
+        mesh: Some(gmesh),
+        ..Default::default()
+    });
+    let scene = root.push(Scene {
+        extensions: None,
+        extras: Default::default(),
+        nodes: vec![node],
+    });
+    root.scene = Some(scene);
+    // gltf-json is built without its `extras` feature: add the target names to the JSON.
+    let mut json = serde_json::to_value(&root).map_err(|e| fail(format!("glTF JSON: {e}")))?;
+    let names: Vec<&str> = shapes.iter().map(|(s, _)| s.as_str()).collect();
+    json["meshes"][0]["extras"] = serde_json::json!({ "targetNames": names });
+    let mut json = serde_json::to_vec(&json).map_err(|e| fail(format!("glTF JSON: {e}")))?;
+    json.resize(json.len().next_multiple_of(4), b' ');
+    bin.resize(bin.len().next_multiple_of(4), 0);
+    let total = u32::try_from(28 + json.len() + bin.len())
+        .map_err(|_| fail("larger than the 4 GiB GLB limit".into()))?;
+    let mut glb = Vec::with_capacity(total as usize);
+    glb.extend_from_slice(b"glTF");
+    glb.extend_from_slice(&2u32.to_le_bytes());
+    glb.extend_from_slice(&total.to_le_bytes());
+    glb.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    glb.extend_from_slice(&0x4E4F_534Au32.to_le_bytes());
+    glb.extend_from_slice(&json);
+    glb.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    glb.extend_from_slice(&0x004E_4942u32.to_le_bytes());
+    glb.extend_from_slice(&bin);
+    write_file(path, &glb)?;
+    let mut csv = String::from("name,max_displacement_m,vertex\n");
+    for (name, d) in &shapes {
+        let (i, m) = d
+            .iter()
+            .enumerate()
+            .map(|(i, v)| (i, v.norm()))
+            .fold((0, 0.0), |a, b| if b.1 > a.1 { b } else { a });
+        csv.push_str(&format!("{name},{m:.6e},{i}\n"));
+    }
+    write_file(&path.with_extension("csv"), csv.as_bytes())
+}
+
+/// Writes bytes to a temporary sibling, then renames it over `path` (parents created).
+fn write_file(path: &Path, bytes: &[u8]) -> Result<(), FaceError> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| FaceError::io(dir, e))?;
+    }
+    let name = path
+        .file_name()
+        .ok_or_else(|| FaceError::io(path, "not a file path"))?;
+    let mut tmp_name = name.to_os_string();
+    tmp_name.push(format!(".tmp{}", std::process::id()));
+    let tmp = path.with_file_name(tmp_name);
+    let result = std::fs::File::create(&tmp)
+        .and_then(|mut f| f.write_all(bytes).and_then(|_| f.sync_all()))
+        .and_then(|_| std::fs::rename(&tmp, path));
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(FaceError::io(path, e));
+    }
+    Ok(())
+}

@@ -1,1 +1,349 @@
-//! (being written)
+//! Files of a textured face for other tools: Wavefront OBJ with its MTL material, and binary
+//! glTF 2.0 (`.glb`) with the texture embedded.
+//!
+//! This file owns the face exports:
+//! - [`write_obj_mtl`]: `v` positions (metres), `vt` texture coordinates (OBJ's `v` up, as
+//!   [`FaceMesh::uvs`]), `vn` area-weighted vertex normals, `f v/vt/vn` faces, `mtllib` and
+//!   `usemtl`, and the `.mtl` next to it whose `map_Kd` names the texture image;
+//! - [`write_textured_obj`]: the same plus the texture written as PNG beside them;
+//! - [`write_glb`]: one mesh with `POSITION`, `NORMAL`, `TEXCOORD_0` (glTF's `v` points down:
+//!   `(u, 1 − v)`), `u32` indices, and a double-sided material whose `baseColorTexture` is the
+//!   texture, stored as PNG in the binary chunk.
+//!
+//! Unlike the cloth exports these do not create folders: a missing folder is an error naming
+//! the file, as is any I/O failure. Files are written to a temporary file and renamed, so a
+//! failure never leaves a half-written file.
+
+use std::io::Cursor;
+use std::path::Path;
+
+use gltf_json::accessor::{ComponentType, Type};
+use gltf_json::buffer::Target;
+use gltf_json::image::MimeType;
+use gltf_json::material::{PbrBaseColorFactor, PbrMetallicRoughness, StrengthFactor};
+use gltf_json::mesh::{Mode, Primitive, Semantic};
+use gltf_json::texture::{Info, MagFilter, MinFilter, Sampler, WrappingMode};
+use gltf_json::validation::Checked::Valid;
+use gltf_json::{Accessor, Image, Material};
+
+use super::render::Texture;
+use super::{FaceError, FaceMesh};
+use crate::geometry::files::write_atomic;
+use crate::geometry::gltf::{f32_bounds, finish_glb, glb_accessor, glb_root, glb_view};
+use crate::geometry::GeometryError;
+
+/// Name of the material in the `.mtl` file and the OBJ's `usemtl`.
+pub const MATERIAL_NAME: &str = "face";
+
+/// A geometry-layer error as a face error naming the file.
+fn from_geometry(path: &Path, e: GeometryError) -> FaceError {
+    match e {
+        GeometryError::Io { path, source } => FaceError::io(path, source),
+        other => FaceError::io(path, other),
+    }
+}
+
+/// Fails, naming `path`, when its folder does not exist or it has no file name.
+fn check_folder(path: &Path) -> Result<(), FaceError> {
+    if path.file_name().is_none() {
+        return Err(FaceError::io(path, "not a file path"));
+    }
+    match path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        Some(dir) if !dir.is_dir() => Err(FaceError::io(
+            path,
+            format!("folder {} does not exist", dir.display()),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Checks that a mesh can be exported: one finite texture coordinate per vertex, finite
+/// positions, valid indices, at least one triangle.
+fn check_mesh(path: &Path, mesh: &FaceMesh) -> Result<(), FaceError> {
+    let bad = |m: String| FaceError::io(path, m);
+    let n = mesh.positions.len();
+    if mesh.uvs.len() != n {
+        return Err(bad(format!(
+            "mesh has {n} positions but {} texture coordinates",
+            mesh.uvs.len()
+        )));
+    }
+    if n == 0 || mesh.triangles.is_empty() {
+        return Err(bad("mesh is empty: nothing to write".into()));
+    }
+    if n > u32::MAX as usize {
+        return Err(bad(format!("{n} vertices do not fit 32-bit indices")));
+    }
+    if let Some(t) = mesh
+        .triangles
+        .iter()
+        .position(|t| t.iter().any(|&i| i as usize >= n))
+    {
+        return Err(bad(format!("triangle {t} has a vertex index beyond {n}")));
+    }
+    if let Some(i) = mesh
+        .positions
+        .iter()
+        .position(|p| !p.iter().all(|c| c.is_finite()))
+    {
+        return Err(bad(format!("vertex {i} has a non-finite position")));
+    }
+    if let Some(i) = mesh
+        .uvs
+        .iter()
+        .position(|t| !t.iter().all(|c| c.is_finite()))
+    {
+        return Err(bad(format!(
+            "vertex {i} has a non-finite texture coordinate"
+        )));
+    }
+    Ok(())
+}
+
+/// Unit vertex normals of `mesh`, `+z` where a vertex has none (unused or degenerate).
+fn unit_normals(mesh: &FaceMesh) -> Vec<[f64; 3]> {
+    mesh.vertex_normals()
+        .iter()
+        .map(|n| {
+            if n.iter().all(|c| c.is_finite()) && (n.norm() - 1.0).abs() < 1e-6 {
+                [n.x, n.y, n.z]
+            } else {
+                [0.0, 0.0, 1.0]
+            }
+        })
+        .collect()
+}
+
+/// Writes `mesh` as a Wavefront OBJ at `obj_path` and its material as `<stem>.mtl` beside it,
+/// whose `map_Kd` is `texture_file_name` (relative to the OBJ's folder, as OBJ readers expect);
+/// see the [module docs](self) for the content.
+///
+/// Fails, naming the file, when its folder does not exist, on a texture name that is empty or
+/// holds a line break, on an invalid mesh, or on an I/O error.
+pub fn write_obj_mtl(
+    obj_path: &Path,
+    mesh: &FaceMesh,
+    texture_file_name: &str,
+) -> Result<(), FaceError> {
+    check_folder(obj_path)?;
+    check_mesh(obj_path, mesh)?;
+    if texture_file_name.trim().is_empty() || texture_file_name.chars().any(char::is_control) {
+        return Err(FaceError::parameter(
+            "texture_file_name",
+            format!("{texture_file_name:?} is not a usable file name"),
+        ));
+    }
+    let mtl_path = obj_path.with_extension("mtl");
+    if mtl_path == obj_path {
+        return Err(FaceError::io(
+            obj_path,
+            "an OBJ file cannot end in .mtl (its material file would overwrite it)",
+        ));
+    }
+    let Some(mtl_name) = mtl_path.file_name().and_then(|n| n.to_str()) else {
+        return Err(FaceError::io(obj_path, "file name is not valid UTF-8"));
+    };
+    let mtl_name = mtl_name.to_string();
+    write_atomic(&mtl_path, |w| {
+        writeln!(w, "# emilion face material")?;
+        writeln!(w, "newmtl {MATERIAL_NAME}")?;
+        writeln!(w, "Ka 1 1 1")?;
+        writeln!(w, "Kd 1 1 1")?;
+        writeln!(w, "Ks 0 0 0")?;
+        writeln!(w, "d 1")?;
+        writeln!(w, "illum 1")?;
+        writeln!(w, "map_Kd {texture_file_name}")
+    })
+    .map_err(|e| from_geometry(&mtl_path, e))?;
+    let normals = unit_normals(mesh);
+    write_atomic(obj_path, |w| {
+        writeln!(
+            w,
+            "# emilion face: {} vertices, {} triangles, metres",
+            mesh.positions.len(),
+            mesh.triangles.len()
+        )?;
+        writeln!(w, "mtllib {mtl_name}")?;
+        for p in &mesh.positions {
+            writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
+        }
+        for t in &mesh.uvs {
+            writeln!(w, "vt {} {}", t[0], t[1])?;
+        }
+        for n in &normals {
+            writeln!(w, "vn {} {} {}", n[0], n[1], n[2])?;
+        }
+        writeln!(w, "usemtl {MATERIAL_NAME}")?;
+        for t in &mesh.triangles {
+            let [a, b, c] = t.map(|i| i + 1);
+            writeln!(w, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}")?;
+        }
+        Ok(())
+    })
+    .map_err(|e| from_geometry(obj_path, e))
+}
+
+/// Writes `<folder>/<stem>.obj`, `<stem>.mtl` and the texture as `<stem>.png`, all in `folder`
+/// (which must exist). Errors as [`write_obj_mtl`] and [`Texture::save`].
+pub fn write_textured_obj(
+    folder: &Path,
+    stem: &str,
+    mesh: &FaceMesh,
+    texture: &Texture,
+) -> Result<(), FaceError> {
+    if stem.is_empty() || stem.contains(['/', '\\']) || stem.chars().any(char::is_control) {
+        return Err(FaceError::parameter(
+            "stem",
+            format!("{stem:?} is not a plain file name"),
+        ));
+    }
+    let png = format!("{stem}.png");
+    let png_path = folder.join(&png);
+    check_folder(&png_path)?;
+    check_texture(&png_path, texture)?;
+    texture.save(&png_path)?;
+    write_obj_mtl(&folder.join(format!("{stem}.obj")), mesh, &png)
+}
+
+/// Fails, naming `path`, on an empty texture or one whose texel count disagrees with its size.
+fn check_texture(path: &Path, texture: &Texture) -> Result<(), FaceError> {
+    let n = texture.width.checked_mul(texture.height);
+    if texture.width == 0 || texture.height == 0 || n != Some(texture.rgb.len()) {
+        return Err(FaceError::io(
+            path,
+            format!(
+                "texture is {}×{} with {} texels",
+                texture.width,
+                texture.height,
+                texture.rgb.len()
+            ),
+        ));
+    }
+    if texture.width > u32::MAX as usize || texture.height > u32::MAX as usize {
+        return Err(FaceError::io(path, "texture too large"));
+    }
+    Ok(())
+}
+
+/// Writes `mesh` textured with `texture` as binary glTF 2.0 at `path`; see the
+/// [module docs](self) for the content.
+///
+/// Fails, naming the file, when its folder does not exist, on an invalid mesh or texture
+/// (empty, or texel count not `width × height`), positions beyond single precision, or an I/O
+/// error.
+pub fn write_glb(path: &Path, mesh: &FaceMesh, texture: &Texture) -> Result<(), FaceError> {
+    check_folder(path)?;
+    check_mesh(path, mesh)?;
+    check_texture(path, texture)?;
+    let mut png = Vec::new();
+    texture
+        .to_image()
+        .write_to(&mut Cursor::new(&mut png), image::ImageFormat::Png)
+        .map_err(|e| FaceError::io(path, format!("texture PNG: {e}")))?;
+
+    let p32: Vec<[f32; 3]> = mesh
+        .positions
+        .iter()
+        .map(|p| [p.x as f32, p.y as f32, p.z as f32])
+        .collect();
+    let (lo, hi) = f32_bounds(&p32).map_err(|m| FaceError::io(path, m))?;
+    let n = mesh.positions.len() as u64;
+    let n_idx = 3 * mesh.triangles.len() as u64;
+
+    // binary chunk: positions, normals, uvs, indices (all 4-byte aligned), then the PNG
+    let mut bin = Vec::with_capacity((32 * n + 4 * n_idx) as usize + png.len());
+    let mut put = |v: f32| bin.extend_from_slice(&v.to_le_bytes());
+    p32.iter().flatten().for_each(|&c| put(c));
+    for nv in unit_normals(mesh) {
+        nv.iter().for_each(|&c| put(c as f32));
+    }
+    for uv in &mesh.uvs {
+        put(uv[0] as f32);
+        put((1.0 - uv[1]) as f32);
+    }
+    for t in &mesh.triangles {
+        t.iter()
+            .for_each(|&i| bin.extend_from_slice(&i.to_le_bytes()));
+    }
+    let (pos_at, nrm_at, uv_at, idx_at) = (0, 12 * n, 24 * n, 32 * n);
+    let png_at = idx_at + 4 * n_idx;
+    bin.extend_from_slice(&png);
+
+    let (mut root, buffer) = glb_root(bin.len());
+    let array = Some(Target::ArrayBuffer);
+    let pos_view = root.push(glb_view(buffer, pos_at, 12 * n, array));
+    let nrm_view = root.push(glb_view(buffer, nrm_at, 12 * n, array));
+    let uv_view = root.push(glb_view(buffer, uv_at, 8 * n, array));
+    let idx_view = root.push(glb_view(
+        buffer,
+        idx_at,
+        4 * n_idx,
+        Some(Target::ElementArrayBuffer),
+    ));
+    let png_view = root.push(glb_view(buffer, png_at, png.len() as u64, None));
+    let pos_acc = root.push(Accessor {
+        min: Some(serde_json::json!(lo)),
+        max: Some(serde_json::json!(hi)),
+        ..glb_accessor(pos_view, n, ComponentType::F32, Type::Vec3)
+    });
+    let nrm_acc = root.push(glb_accessor(nrm_view, n, ComponentType::F32, Type::Vec3));
+    let uv_acc = root.push(glb_accessor(uv_view, n, ComponentType::F32, Type::Vec2));
+    let idx_acc = root.push(glb_accessor(
+        idx_view,
+        n_idx,
+        ComponentType::U32,
+        Type::Scalar,
+    ));
+    let image = root.push(Image {
+        buffer_view: Some(png_view),
+        mime_type: Some(MimeType("image/png".into())),
+        uri: None,
+        extensions: None,
+        extras: Default::default(),
+    });
+    let sampler = root.push(Sampler {
+        mag_filter: Some(Valid(MagFilter::Linear)),
+        min_filter: Some(Valid(MinFilter::Linear)),
+        wrap_s: Valid(WrappingMode::ClampToEdge),
+        wrap_t: Valid(WrappingMode::ClampToEdge),
+        ..Default::default()
+    });
+    let texture_index = root.push(gltf_json::Texture {
+        sampler: Some(sampler),
+        source: image,
+        extensions: None,
+        extras: Default::default(),
+    });
+    let material = root.push(Material {
+        double_sided: true,
+        pbr_metallic_roughness: PbrMetallicRoughness {
+            base_color_factor: PbrBaseColorFactor([1.0, 1.0, 1.0, 1.0]),
+            base_color_texture: Some(Info {
+                index: texture_index,
+                tex_coord: 0,
+                extensions: None,
+                extras: Default::default(),
+            }),
+            metallic_factor: StrengthFactor(0.0),
+            roughness_factor: StrengthFactor(0.8),
+            ..Default::default()
+        },
+        ..Default::default()
+    });
+    let primitive = Primitive {
+        attributes: [
+            (Valid(Semantic::Positions), pos_acc),
+            (Valid(Semantic::Normals), nrm_acc),
+            (Valid(Semantic::TexCoords(0)), uv_acc),
+        ]
+        .into_iter()
+        .collect(),
+        extensions: None,
+        extras: Default::default(),
+        indices: Some(idx_acc),
+        material: Some(material),
+        mode: Valid(Mode::Triangles),
+        targets: None,
+    };
+    finish_glb(path, root, vec![primitive], bin).map_err(|e| from_geometry(path, e))
+}

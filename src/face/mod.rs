@@ -14,7 +14,8 @@
 //!   the signed error map between two surfaces;
 //! - [`head_pose`], [`skin`], [`sequence`], [`sequence_files`]: synthetic sequences with ground
 //!   truth (pose and FAP trajectories) and reading sequence folders;
-//! - [`gray`], [`samples`], [`tracker`]: tracking of head pose and expression.
+//! - [`gray`], [`samples`], [`tracker`], [`track_run`]: tracking of head pose and expression,
+//!   and its outputs.
 
 pub mod adapt;
 pub mod blendshapes;
@@ -38,6 +39,7 @@ pub mod sequence;
 pub mod sequence_files;
 pub mod skin;
 pub mod texture_bake;
+pub mod track_run;
 pub mod tracker;
 pub mod view_fit;
 

@@ -17,7 +17,8 @@
 //!
 //! Trajectories: yaw ±`yaw_deg`, pitch ±½·`yaw_deg`, roll ±⅓·`yaw_deg` and a translation of
 //! ±1.5 cm, as sums of slow sines; each FAP moves between its range's ends as a raised cosine
-//! of its own frequency (0.3–0.9 Hz) and phase, so expressions build up and relax. Lighting:
+//! of its own frequency (0.3–0.9 Hz), starting from the neutral face after its own delay (up to
+//! 0.2 s), so expressions build up and relax. Lighting:
 //! a global gain of 1 ± `light` per frame (slow), then Gaussian noise of σ = `noise`.
 
 use std::path::Path;
@@ -35,9 +36,6 @@ use super::FaceError;
 use crate::geometry::{write_obj, SplitMix64, Vec3};
 use crate::tracking::camera::Camera;
 use nalgebra::Matrix3;
-
-/// FAPs animated by default (until the rig names its tracked set).
-pub const DEFAULT_FAPS: [u8; 9] = [3, 12, 13, 6, 7, 31, 32, 19, 20];
 
 /// Settings of [`make_face_sequence`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -88,7 +86,7 @@ impl Default for FaceSequenceOptions {
             distance: 0.6,
             focal: 1000.0,
             yaw_deg: 20.0,
-            faps: DEFAULT_FAPS.to_vec(),
+            faps: super::fap::TRACKED_FAPS.to_vec(),
             noise: 2.0,
             light: 0.04,
             texture_size: 512,
@@ -220,15 +218,21 @@ pub fn trajectory(
         .enumerate()
         .map(|(i, &(lo, hi))| {
             let f = 0.3 + 0.6 * ((i as f64 * 0.618_034) % 1.0);
-            let ph = phase();
-            // rest value: 0 when inside the range, else the nearer end
+            // every expression starts from the neutral face (the first frame textures the
+            // model, as in the seed's protocol), with its own delay
+            let ph = -tau * f * 0.2 * phase() / tau; // a delay of up to 0.2 s
+                                                     // rest value: 0 when inside the range, else the nearer end
             let rest = 0.0f64.clamp(lo, hi);
             let peak = if (hi - rest).abs() >= (lo - rest).abs() {
                 hi
             } else {
                 lo
             };
-            let s = 0.5 - 0.5 * (tau * f * t + ph).cos();
+            let s = if t + ph / (tau * f) <= 0.0 {
+                0.0
+            } else {
+                0.5 - 0.5 * (tau * f * t + ph).cos()
+            };
             rest + (peak - rest) * s
         })
         .collect();

@@ -122,6 +122,15 @@ struct View {
     vis: Vec<f32>,
 }
 
+/// Tracked FAPs whose zones overlap, and the samples they move.
+#[derive(Clone, Debug)]
+struct FapGroup {
+    /// Indices into the tracked FAPs.
+    members: Vec<usize>,
+    /// Samples moved by any member.
+    active: Vec<usize>,
+}
+
 /// Per-thread buffers of the annealing cost.
 #[derive(Default)]
 struct CostScratch {
@@ -144,8 +153,8 @@ pub struct FaceTracker {
     samples: SurfaceSamples,
     /// Learnt grey of each sample at full and half resolution (NaN: never seen).
     colours: [Vec<f32>; 2],
-    /// Samples whose triangle moves with a tracked FAP.
-    active: Vec<usize>,
+    /// Groups of tracked FAPs searched together.
+    groups: Vec<FapGroup>,
     pivot: Vec3,
     pose: HeadPose,
     faps: Vec<f64>,
@@ -215,19 +224,51 @@ impl FaceTracker {
             values[i] = v;
         }
         let samples = SurfaceSamples::on_texture_grid(mesh, options.sample_grid);
-        // samples moved by a tracked FAP
-        let mut moving = vec![false; mesh.vertex_count()];
+        // FAPs whose zones overlap are searched together; each group's cost reads only the
+        // samples its FAPs move
+        let mut moves: Vec<Vec<bool>> = Vec::new();
         let mut probe = vec![0.0; rig.len()];
         let mut moved = Vec::new();
         for &i in &tracked {
             probe[i] = 1.0;
             rig.apply(&mesh.positions, &probe, &mut moved);
             probe[i] = 0.0;
-            for (m, (a, b)) in moving.iter_mut().zip(moved.iter().zip(&mesh.positions)) {
-                *m |= a != b;
+            moves.push(
+                moved
+                    .iter()
+                    .zip(&mesh.positions)
+                    .map(|(a, b)| a != b)
+                    .collect(),
+            );
+        }
+        let mut group_of: Vec<usize> = (0..tracked.len()).collect();
+        for a in 0..tracked.len() {
+            for b in 0..a {
+                if moves[a].iter().zip(&moves[b]).any(|(x, y)| *x && *y) {
+                    let (ga, gb) = (group_of[a], group_of[b]);
+                    for g in group_of.iter_mut() {
+                        if *g == ga {
+                            *g = gb;
+                        }
+                    }
+                }
             }
         }
-        let active = samples.touching(&mesh.triangles, &moving);
+        let mut groups = Vec::new();
+        for g in 0..tracked.len() {
+            let members: Vec<usize> = (0..tracked.len()).filter(|&k| group_of[k] == g).collect();
+            if members.is_empty() {
+                continue;
+            }
+            let mut moving = vec![false; mesh.vertex_count()];
+            for &k in &members {
+                for (m, x) in moving.iter_mut().zip(&moves[k]) {
+                    *m |= *x;
+                }
+            }
+            let active = samples.touching(&mesh.triangles, &moving);
+            groups.push(FapGroup { members, active });
+        }
         let (w, h) = (cameras[0].width as usize, cameras[0].height as usize);
         let views = cameras
             .iter()
@@ -246,7 +287,7 @@ impl FaceTracker {
             tracked,
             ranges,
             colours: [Vec::new(), Vec::new()],
-            active,
+            groups,
             samples,
             pose,
             faps: values,
@@ -510,49 +551,49 @@ impl FaceTracker {
         }
     }
 
-    /// Simulated annealing of the tracked FAP values.
+    /// Simulated annealing of the tracked FAP values, group after group.
     fn anneal_faps(&mut self, rng: &mut SplitMix64) {
-        if self.tracked.is_empty() {
-            return;
+        for g in 0..self.groups.len() {
+            self.anneal_group(g, rng);
         }
-        let start: Vec<f64> = self.tracked.iter().map(|&i| self.faps[i]).collect();
+    }
+
+    /// Simulated annealing of one group of FAPs (the others fixed).
+    fn anneal_group(&mut self, g: usize, rng: &mut SplitMix64) {
+        let group = &self.groups[g];
+        let members: Vec<usize> = group.members.iter().map(|&k| self.tracked[k]).collect();
+        let start: Vec<f64> = members.iter().map(|&i| self.faps[i]).collect();
         let dofs: Vec<usize> = (0..start.len()).collect();
-        let sigma: Vec<f64> = self
-            .ranges
+        let ranges: Vec<(f64, f64)> = group.members.iter().map(|&k| self.ranges[k]).collect();
+        let sigma: Vec<f64> = ranges
             .iter()
             .map(|(lo, hi)| self.options.fap_spread * (hi - lo))
             .collect();
         let layers = self.options.layers;
         let settings = AnnealSettings {
-            particles: self.options.particles,
+            particles: self.options.particles * start.len().div_ceil(2).max(1),
             levels: (0..layers).map(|l| usize::from(l < layers / 2)).collect(),
             survival: 0.5,
             decay: 0.6,
         };
-        let ranges = &self.ranges;
         let clamp = |p: &mut [f64]| {
-            for (x, (lo, hi)) in p.iter_mut().zip(ranges) {
+            for (x, (lo, hi)) in p.iter_mut().zip(&ranges) {
                 *x = x.clamp(*lo, *hi);
             }
         };
         let s2 = self.options.robust_sigma.powi(2);
-        let (rig, mesh, tracked, base, pose, pivot) = (
-            &self.rig,
-            &self.mesh,
-            &self.tracked,
-            &self.faps,
-            &self.pose,
-            &self.pivot,
-        );
-        let (samples, active, views, colours) =
-            (&self.samples, &self.active, &self.views, &self.colours);
+        let (rig, mesh, base, pose, pivot) =
+            (&self.rig, &self.mesh, &self.faps, &self.pose, &self.pivot);
+        let (samples, views, colours) = (&self.samples, &self.views, &self.colours);
+        let active = &group.active;
+        let members = &members;
         let cost = |p: &[f64], level: usize| -> f64 {
             COST_SCRATCH.with(|cell| {
                 let mut s = cell.borrow_mut();
                 let s = &mut *s;
                 s.values.clear();
                 s.values.extend_from_slice(base);
-                for (&i, &v) in tracked.iter().zip(p) {
+                for (&i, &v) in members.iter().zip(p) {
                     s.values[i] = v;
                 }
                 rig.apply(&mesh.positions, &s.values, &mut s.deformed);
@@ -560,16 +601,16 @@ impl FaceTracker {
                 let shift = pivot + pose.translation;
                 let mut total = 0.0;
                 for &k in active {
+                    let c = colours[level][k];
+                    if !c.is_finite() {
+                        continue;
+                    }
                     let t = mesh.triangles[samples.triangle[k] as usize];
                     let b = samples.bary[k];
                     let x = s.deformed[t[0] as usize] * b[0]
                         + s.deformed[t[1] as usize] * b[1]
                         + s.deformed[t[2] as usize] * b[2];
                     let x = rot * (x - pivot) + shift;
-                    let c = colours[level][k];
-                    if !c.is_finite() {
-                        continue;
-                    }
                     for v in views {
                         let w = v.vis[k] as f64;
                         if w <= 0.0 {
@@ -598,7 +639,7 @@ impl FaceTracker {
             cost,
             &mut self.anneal_scratch,
         );
-        for (&i, &v) in self.tracked.iter().zip(&result.params) {
+        for (&i, &v) in members.iter().zip(&result.params) {
             self.faps[i] = v;
         }
     }
@@ -647,6 +688,23 @@ impl FaceTracker {
             faps: self.tracked.iter().map(|&i| self.faps[i]).collect(),
             cost: if w > 0.0 { c / w } else { f64::NAN },
         })
+    }
+
+    /// The photometric cost (sum over cameras and samples of the weighted robust error) of the
+    /// current frame at `pose` and tracked FAP values `faps`, at full resolution (`level` 0) or
+    /// half (1), with the current visibility and gains. For diagnostics and tests.
+    pub fn cost_at(&mut self, pose: &HeadPose, faps: &[f64], level: usize) -> f64 {
+        let (saved_pose, saved_faps) = (self.pose, self.faps.clone());
+        self.pose = *pose;
+        for (&i, &v) in self.tracked.iter().zip(faps) {
+            self.faps[i] = v;
+        }
+        self.pose_samples();
+        let c = self.rigid_cost(level.min(1)).0;
+        self.pose = saved_pose;
+        self.faps = saved_faps;
+        self.pose_samples();
+        c
     }
 
     /// The posed, deformed vertices of the last tracked frame.

@@ -18,6 +18,7 @@ pub mod contact;
 pub mod convert;
 pub mod docs;
 pub mod fabric;
+pub mod face;
 pub mod facade;
 pub mod facade_analysis;
 pub mod garment;
@@ -118,6 +119,7 @@ pub fn build_engine_with(limits: EngineLimits) -> Engine {
     facade::register(&mut engine);
     facade_analysis::register(&mut engine);
     tracking::register(&mut engine);
+    face::register(&mut engine);
     tracking_sequence::register(&mut engine);
     kes::register(&mut engine);
     engine

@@ -28,7 +28,7 @@ const KEYS: [&str; 14] = [
 
 /// A number from an integer, a float or a numeric string (values given with `--set` arrive as
 /// strings).
-fn number(d: &Dynamic, what: &str) -> RResult<f64> {
+pub(super) fn number(d: &Dynamic, what: &str) -> RResult<f64> {
     let v = if let Some(f) = d.clone().try_cast::<FLOAT>() {
         Some(f)
     } else if let Some(i) = d.clone().try_cast::<INT>() {
@@ -48,7 +48,7 @@ fn number(d: &Dynamic, what: &str) -> RResult<f64> {
 }
 
 /// A non-negative integer from a number or a numeric string.
-fn whole(d: &Dynamic, what: &str) -> RResult<u64> {
+pub(super) fn whole(d: &Dynamic, what: &str) -> RResult<u64> {
     let v = number(d, what)?;
     if v < 0.0 || v.fract() != 0.0 || v > 1e15 {
         return Err(rt_err(format!(
@@ -59,7 +59,7 @@ fn whole(d: &Dynamic, what: &str) -> RResult<u64> {
 }
 
 /// A boolean from `true`/`false` or the strings "true"/"false".
-fn flag(d: &Dynamic, what: &str) -> RResult<bool> {
+pub(super) fn flag(d: &Dynamic, what: &str) -> RResult<bool> {
     if let Ok(b) = d.as_bool() {
         return Ok(b);
     }

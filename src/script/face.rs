@@ -1,0 +1,165 @@
+//! Script bindings of the face module: synthetic face sequences and face tracking.
+
+use std::io::IsTerminal;
+use std::path::Path;
+
+use indicatif::ProgressBar;
+use rhai::{Dynamic, Engine, Map, INT};
+
+use super::convert::{rt_err, RResult};
+use super::register;
+use super::tracking_sequence::{number, whole};
+use crate::face::sequence::{make_face_sequence, FaceSequenceOptions};
+use crate::face::sequence_files::FaceSequence;
+use crate::face::track_run::{track_face_sequence, write_face_track_outputs};
+use crate::face::tracker::FaceTrackerOptions;
+
+fn sequence_options(m: &Map) -> RResult<FaceSequenceOptions> {
+    let mut o = FaceSequenceOptions::default();
+    for (k, v) in m {
+        let k = k.as_str();
+        match k {
+            "frames" => o.frames = whole(v, k)? as usize,
+            "fps" => o.fps = number(v, k)?,
+            "width" => o.width = whole(v, k)?.min(u32::MAX as u64) as u32,
+            "height" => o.height = whole(v, k)?.min(u32::MAX as u64) as u32,
+            "cameras" => o.cameras = whole(v, k)? as usize,
+            "distance" => o.distance = number(v, k)?,
+            "focal" => o.focal = number(v, k)?,
+            "yaw_deg" => o.yaw_deg = number(v, k)?,
+            "noise" => o.noise = number(v, k)?,
+            "light" => o.light = number(v, k)?,
+            "texture_size" => o.texture_size = whole(v, k)? as usize,
+            "seed" => o.seed = whole(v, k)?,
+            "texture" => o.texture = Some(v.to_string()),
+            "model" => o.model = Some(v.to_string()),
+            "backgrounds" => o.backgrounds = Some(v.to_string()),
+            "faps" => {
+                let arr = v
+                    .read_lock::<rhai::Array>()
+                    .ok_or_else(|| rt_err("`faps` must be an array of FAP numbers"))?;
+                o.faps = arr
+                    .iter()
+                    .map(|d| whole(d, "faps[]").map(|n| n.min(255) as u8))
+                    .collect::<RResult<Vec<_>>>()?;
+            }
+            other => {
+                return Err(rt_err(format!(
+                    "make_face_sequence: unknown option `{other}` (frames, fps, width, height, \
+                     cameras, distance, focal, yaw_deg, noise, light, texture_size, seed, \
+                     texture, model, backgrounds, faps)"
+                )))
+            }
+        }
+    }
+    Ok(o)
+}
+
+fn make(out: &str, m: &Map) -> RResult<Map> {
+    let o = sequence_options(m)?;
+    let info = make_face_sequence(Path::new(out), &o).map_err(rt_err)?;
+    let mut r = Map::new();
+    r.insert("frames".into(), Dynamic::from_int(info.frames as INT));
+    r.insert(
+        "cameras".into(),
+        Dynamic::from_int(info.cameras.len() as INT),
+    );
+    r.insert(
+        "faps".into(),
+        Dynamic::from_array(
+            info.faps
+                .iter()
+                .map(|&f| Dynamic::from_int(f as INT))
+                .collect(),
+        ),
+    );
+    Ok(r)
+}
+
+fn track(seq_dir: &str, out: &str, m: &Map) -> RResult<Map> {
+    let mut o = FaceTrackerOptions::default();
+    let (mut frames, mut overlay_every) = (None, 1usize);
+    for (k, v) in m {
+        let k = k.as_str();
+        match k {
+            "frames" => frames = Some(whole(v, k)? as usize),
+            "overlay_every" => overlay_every = whole(v, k)? as usize,
+            "sample_grid" => o.sample_grid = whole(v, k)? as usize,
+            "gn_coarse" => o.gn_coarse = whole(v, k)? as usize,
+            "gn_fine" => o.gn_fine = whole(v, k)? as usize,
+            "particles" => o.particles = whole(v, k)? as usize,
+            "layers" => o.layers = whole(v, k)? as usize,
+            "fap_spread" => o.fap_spread = number(v, k)?,
+            "prediction" => o.prediction = number(v, k)?,
+            "robust_sigma" => o.robust_sigma = number(v, k)?,
+            "seed" => o.seed = whole(v, k)?,
+            other => {
+                return Err(rt_err(format!(
+                    "face_track: unknown option `{other}` (frames, overlay_every, sample_grid, \
+                     gn_coarse, gn_fine, particles, layers, fap_spread, prediction, \
+                     robust_sigma, seed)"
+                )))
+            }
+        }
+    }
+    let seq = FaceSequence::open(Path::new(seq_dir)).map_err(rt_err)?;
+    let total = frames.map_or(seq.info.frames, |f| f.min(seq.info.frames));
+    let bar = std::io::stderr()
+        .is_terminal()
+        .then(|| ProgressBar::new(total as u64));
+    let result = track_face_sequence(&seq, &o, frames, |done, _| {
+        if let Some(b) = &bar {
+            b.set_position(done as u64);
+        }
+    })
+    .map_err(rt_err)?;
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let files =
+        write_face_track_outputs(&seq, &result, Path::new(out), overlay_every).map_err(rt_err)?;
+    let f = |x: Option<f64>| x.map_or(Dynamic::UNIT, Dynamic::from_float);
+    let mut r = Map::new();
+    r.insert("frames".into(), Dynamic::from_int(result.rows.len() as INT));
+    r.insert("pose_err_deg".into(), f(result.mean_pose_err_deg()));
+    r.insert("pose_err_max_deg".into(), f(result.max_pose_err_deg()));
+    r.insert("fap_err".into(), f(result.mean_fap_err()));
+    r.insert("fap_err_max".into(), f(result.max_fap_err()));
+    r.insert("fps".into(), Dynamic::from_float(result.fps()));
+    r.insert("files".into(), Dynamic::from_int(files.len() as INT));
+    Ok(r)
+}
+
+/// Registers the face functions.
+pub fn register(engine: &mut Engine) {
+    register!(
+        engine,
+        "make_face_sequence",
+        ["out: String", "options: Map", "Map"],
+        "Writes a synthetic face sequence with ground truth under `out`: the neutral model
+(`model.obj`), its pose and expression (MPEG-4 FAP values) per frame (`ground_truth.csv`,
+`init.csv` for frame 0), cameras (`cameras/camN.json`) and frames (`images/camN/NNNN.png`):
+the textured face rendered from several cameras over real photos with lighting change and
+noise. Options: `frames` (50), `fps` (25), `width` (640), `height` (480), `cameras` (3),
+`distance` (m, 0.6), `focal` (px, 1000), `yaw_deg` (20), `noise` (2), `light` (0.04),
+`texture_size` (512), `seed`, `texture` (PNG in the mesh's UV layout), `model` (OBJ in
+metres), `backgrounds` (folder of photos), `faps` (array of FAP numbers). Returns
+#{frames, cameras, faps}.",
+        |out: &str, m: Map| make(out, &m)
+    );
+    register!(
+        engine,
+        "face_track",
+        ["seq: String", "out: String", "options: Map", "Map"],
+        "Tracks the head pose and expression in a face sequence folder (as `make_face_sequence`
+writes: cameras, images, the neutral `model.obj` and `init.csv` with the first frame's pose
+and FAPs): the model is textured from the first frame, then each frame's pose is found by
+Gauss–Newton on the photometric error and its FAP values by simulated annealing. Writes
+`tracked.csv`, `errors.csv` and `summary.json` (with ground truth) and `overlay/NNNN.png`
+under `out`. Options: `frames`, `overlay_every` (1; 0: none), `sample_grid`, `gn_coarse`,
+`gn_fine`, `particles`, `layers`, `fap_spread`, `prediction`, `robust_sigma`, `seed`.
+Returns #{frames, pose_err_deg, pose_err_max_deg, fap_err, fap_err_max (fractions of each
+FAP's range; () without ground truth), fps, files}.",
+        |seq: &str, out: &str, m: Map| track(seq, out, &m)
+    );
+}
