@@ -5,7 +5,8 @@
 //! - [`error`]: the module's error type;
 //! - [`model`]: the generic face mesh (MediaPipe canonical mesh, metres) and its measures;
 //! - [`landmarks`]: the 68-point iBUG landmark scheme mapped onto the mesh, `.pts` files;
-//! - [`render`]: textured, z-buffered rendering of a face mesh through a camera;
+//! - [`render`]: textured, z-buffered rendering of a face mesh through a camera; [`preview`]:
+//!   shaded pictures and the expression gallery;
 //! - [`candide`], [`fap`], [`muscles`], [`expressions`], [`blendshapes`]: animation — the
 //!   CANDIDE-3 model, MPEG-4 FAPs on the mesh, Bézier muscles, named sliders, ARKit-52 export;
 //! - [`regions`], [`rbf`], [`contour`], [`view_fit`], [`adapt`]: adaptation of the generic mesh
@@ -33,6 +34,7 @@ pub mod model;
 pub mod muscles;
 pub mod rbf;
 pub mod regions;
+pub mod preview;
 pub mod render;
 pub mod samples;
 pub mod sequence;

@@ -9,6 +9,12 @@ use rhai::{Dynamic, Engine, Map, INT};
 use super::convert::{rt_err, RResult};
 use super::register;
 use super::tracking_sequence::{number, whole};
+use crate::face::blendshapes::write_arkit_glb;
+use crate::face::expressions::Expressions;
+use crate::face::fap::FapRig;
+use crate::face::model::FaceMesh;
+use crate::face::muscles::MuscleRig;
+use crate::face::preview::expression_image;
 use crate::face::sequence::{make_face_sequence, FaceSequenceOptions};
 use crate::face::sequence_files::FaceSequence;
 use crate::face::track_run::{track_face_sequence, write_face_track_outputs};
@@ -130,6 +136,28 @@ fn track(seq_dir: &str, out: &str, m: &Map) -> RResult<Map> {
     Ok(r)
 }
 
+fn expression_png(path: &str, m: &Map, yaw_deg: f64) -> RResult<()> {
+    let values = m
+        .iter()
+        .map(|(k, v)| Ok((k.to_string(), number(v, k)?)))
+        .collect::<RResult<Vec<_>>>()?;
+    let img = expression_image(&values, 512, yaw_deg).map_err(rt_err)?;
+    if let Some(dir) = Path::new(path).parent() {
+        std::fs::create_dir_all(dir).map_err(|e| rt_err(format!("{}: {e}", dir.display())))?;
+    }
+    img.save(path).map_err(|e| rt_err(format!("{path}: {e}")))
+}
+
+fn arkit(path: &str) -> RResult<()> {
+    let mesh = FaceMesh::mediapipe().map_err(rt_err)?;
+    let faps = FapRig::new(&mesh).map_err(rt_err)?;
+    let muscles = MuscleRig::mediapipe(&mesh).map_err(rt_err)?;
+    if let Some(dir) = Path::new(path).parent() {
+        std::fs::create_dir_all(dir).map_err(|e| rt_err(format!("{}: {e}", dir.display())))?;
+    }
+    write_arkit_glb(Path::new(path), &mesh, &faps, &muscles).map_err(rt_err)
+}
+
 /// Registers the face functions.
 pub fn register(engine: &mut Engine) {
     register!(
@@ -161,5 +189,45 @@ under `out`. Options: `frames`, `overlay_every` (1; 0: none), `sample_grid`, `gn
 Returns #{frames, pose_err_deg, pose_err_max_deg, fap_err, fap_err_max (fractions of each
 FAP's range; () without ground truth), fps, files}.",
         |seq: &str, out: &str, m: Map| track(seq, out, &m)
+    );
+    register!(
+        engine,
+        "face_sliders",
+        ["Array"],
+        "Names of the expression sliders of the generic face (the seed's interface sliders such
+as `Mouth width` or `Left eyelid`, then the six basic expressions `smile`, `surprise`, `anger`, `sadness`,
+`disgust`, `fear`), in order.",
+        || -> RResult<rhai::Array> {
+            let mesh = FaceMesh::mediapipe().map_err(rt_err)?;
+            let ex = Expressions::new(&mesh).map_err(rt_err)?;
+            Ok(ex.names().into_iter().map(|n| Dynamic::from(n.to_string())).collect())
+        }
+    );
+    register!(
+        engine,
+        "face_expression_png",
+        ["path: String", "values: Map", "()"],
+        "Renders the generic face (MediaPipe canonical mesh with a procedural skin texture,
+shaded, frontal, 512×512) with an expression to a PNG: `values` maps slider names (see
+`face_sliders`) and MPEG-4 FAPs written `fap_N` (in FAP units: value / 1024 × FAPU) to their
+values, e.g. #{ smile: 1.0 } or #{ fap_3: 800 }.",
+        |path: &str, m: Map| expression_png(path, &m, 0.0)
+    );
+    register!(
+        engine,
+        "face_expression_png",
+        ["path: String", "values: Map", "yaw_deg: f64", "()"],
+        "As `face_expression_png(path, values)`, seen from `yaw_deg` degrees to the side
+(positive: from the subject's left).",
+        |path: &str, m: Map, yaw: f64| expression_png(path, &m, yaw)
+    );
+    register!(
+        engine,
+        "face_export_arkit",
+        ["path: String", "()"],
+        "Writes the generic face as a glTF binary (.glb) with the 52 ARKit-style blendshapes as
+named morph targets (`extras.targetNames`, the names Blender, Unity and three.js read), made
+from the FAPs and muscles, and beside it a CSV of each shape's largest displacement.",
+        |path: &str| arkit(path)
     );
 }
