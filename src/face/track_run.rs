@@ -28,6 +28,9 @@ pub struct FaceTrackResult {
     pub seconds: f64,
     /// Mean photometric cost per frame.
     pub cost: Vec<f64>,
+    /// Seconds per frame in each stage: reading the image files, then the tracker's
+    /// [`STAGES`](super::tracker::STAGES).
+    pub stage_seconds: Vec<(String, f64)>,
 }
 
 impl FaceTrackResult {
@@ -83,10 +86,13 @@ pub fn track_face_sequence(
         options,
     )?;
     let start = Instant::now();
+    let mut reading = 0.0;
     let mut rows = Vec::with_capacity(total);
     let mut cost = Vec::with_capacity(total);
     for k in 0..total {
+        let t = Instant::now();
         let images = seq.frame_images(k)?;
+        reading += t.elapsed().as_secs_f64();
         let r = tracker.track(&images)?;
         if !(r.pose.translation.iter().all(|v| v.is_finite())
             && r.faps.iter().all(|v| v.is_finite()))
@@ -105,6 +111,11 @@ pub fn track_face_sequence(
         progress(k + 1, total);
     }
     let seconds = start.elapsed().as_secs_f64();
+    let n = rows.len().max(1) as f64;
+    let mut stage_seconds = vec![("read".to_string(), reading / n)];
+    for (name, s) in super::tracker::STAGES.iter().zip(tracker.stage_seconds()) {
+        stage_seconds.push((name.to_string(), s / n));
+    }
     let (mut pose_err_deg, mut translation_err, mut fap_err) = (None, None, None);
     if let Some(truth) = &seq.truth {
         let n = rows.len().min(truth.len());
@@ -139,6 +150,7 @@ pub fn track_face_sequence(
         fap_err,
         seconds,
         cost,
+        stage_seconds,
     })
 }
 
@@ -185,6 +197,7 @@ pub fn write_face_track_outputs(
         "fap_err_fraction_of_range": result.mean_fap_err(),
         "fap_err_by_fap": result.fap_err.as_ref().map(|e| seq.info.faps.iter().zip(e).map(|(f, v)| (format!("fap_{f}"), *v)).collect::<std::collections::BTreeMap<_, _>>()),
         "seconds": result.seconds,
+        "seconds_per_frame_by_stage": result.stage_seconds.iter().cloned().collect::<std::collections::BTreeMap<_, _>>(),
     });
     let path = out.join("summary.json");
     std::fs::write(

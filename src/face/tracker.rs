@@ -39,7 +39,8 @@ use image::RgbImage;
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default)]
 pub struct FaceTrackerOptions {
-    /// Cells per side of the sample grid over the texture layout. Default 150.
+    /// Cells per side of the sample grid over the texture layout. Default 100 (about 6,500
+    /// samples on the canonical face).
     pub sample_grid: usize,
     /// Gauss–Newton iterations at half resolution. Default 5.
     pub gn_coarse: usize,
@@ -62,7 +63,7 @@ pub struct FaceTrackerOptions {
 impl Default for FaceTrackerOptions {
     fn default() -> Self {
         FaceTrackerOptions {
-            sample_grid: 150,
+            sample_grid: 100,
             gn_coarse: 5,
             gn_fine: 4,
             particles: 24,
@@ -169,7 +170,12 @@ pub struct FaceTracker {
     blur_scratch: Vec<f32>,
     anneal_scratch: AnnealScratch,
     frame: usize,
+    /// Seconds spent per stage over all frames: images, visibility, rigid, expression.
+    stage_seconds: [f64; 4],
 }
+
+/// Names of the tracker's stages, in the order of [`FaceTracker::stage_seconds`].
+pub const STAGES: [&str; 4] = ["images", "visibility", "pose", "expression"];
 
 /// What the tracker found for one frame.
 #[derive(Clone, Debug, PartialEq)]
@@ -302,6 +308,7 @@ impl FaceTracker {
             blur_scratch: Vec::new(),
             anneal_scratch: AnnealScratch::default(),
             frame: 0,
+            stage_seconds: [0.0; 4],
         })
     }
 
@@ -647,7 +654,14 @@ impl FaceTracker {
     /// Tracks one frame: `images` one per camera, in the cameras' order. The first call
     /// learns the texture at the initial pose and returns that pose refined.
     pub fn track(&mut self, images: &[RgbImage]) -> Result<FaceFrameResult, FaceError> {
+        let mut clock = std::time::Instant::now();
+        let mut lap = |stage: usize, s: &mut [f64; 4]| {
+            s[stage] += clock.elapsed().as_secs_f64();
+            clock = std::time::Instant::now();
+        };
+        let mut times = [0.0; 4];
         self.load_images(images)?;
+        lap(0, &mut times);
         let mut rng = SplitMix64::new(
             self.options.seed ^ (self.frame as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15),
         );
@@ -656,6 +670,7 @@ impl FaceTracker {
             for v in &mut self.views {
                 v.gain = 1.0;
             }
+            lap(1, &mut times);
         } else {
             // prediction
             let (pose0, faps0) = (self.pose, self.faps.clone());
@@ -672,13 +687,23 @@ impl FaceTracker {
             self.previous = Some((pose0, faps0));
             self.update_visibility();
             self.update_gains(1);
+            lap(1, &mut times);
             self.gauss_newton(1, self.options.gn_coarse);
+            lap(2, &mut times);
             self.update_visibility();
             self.update_gains(0);
+            lap(1, &mut times);
             self.gauss_newton(0, self.options.gn_fine);
+            lap(2, &mut times);
             self.anneal_faps(&mut rng);
+            lap(3, &mut times);
             self.update_visibility();
+            lap(1, &mut times);
             self.gauss_newton(0, self.options.gn_fine);
+            lap(2, &mut times);
+        }
+        for (a, b) in self.stage_seconds.iter_mut().zip(times) {
+            *a += b;
         }
         self.pose_samples();
         let (c, w) = self.rigid_cost(0);
@@ -705,6 +730,11 @@ impl FaceTracker {
         self.faps = saved_faps;
         self.pose_samples();
         c
+    }
+
+    /// Seconds spent so far in each stage ([`STAGES`]), all frames together.
+    pub fn stage_seconds(&self) -> [f64; 4] {
+        self.stage_seconds
     }
 
     /// The posed, deformed vertices of the last tracked frame.
