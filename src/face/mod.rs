@@ -9,8 +9,8 @@
 //!   shaded pictures and the expression gallery;
 //! - [`candide`], [`fap`], [`muscles`], [`expressions`], [`blendshapes`]: animation — the
 //!   CANDIDE-3 model, MPEG-4 FAPs on the mesh, Bézier muscles, named sliders, ARKit-52 export;
-//! - [`regions`], [`rbf`], [`contour`], [`view_fit`], [`adapt`]: adaptation of the generic mesh
-//!   to a person's photos;
+//! - [`regions`], [`rbf`], [`contour`], [`view_fit`], [`adapt`], [`align`], [`fit_run`]:
+//!   adaptation of the generic mesh to a person's photos, and its outputs;
 //! - [`texture_bake`], [`export`], [`error_map`]: texture from photos, OBJ+MTL and glTF files,
 //!   the signed error map between two surfaces;
 //! - [`head_pose`], [`skin`], [`sequence`], [`sequence_files`]: synthetic sequences with ground
@@ -19,6 +19,7 @@
 //!   and its outputs.
 
 pub mod adapt;
+pub mod align;
 pub mod blendshapes;
 pub mod candide;
 pub mod contour;
@@ -27,6 +28,7 @@ pub mod error_map;
 pub mod export;
 pub mod expressions;
 pub mod fap;
+pub mod fit_run;
 pub mod gray;
 pub mod head_pose;
 pub mod landmarks;

@@ -184,6 +184,23 @@ impl FaceMesh {
         nb
     }
 
+    /// The edges of the triangles, each once, as `(low, high)` vertex pairs, sorted.
+    pub fn edges(&self) -> Vec<(usize, usize)> {
+        let mut e: Vec<(usize, usize)> = self
+            .triangles
+            .iter()
+            .flat_map(|t| {
+                (0..3).map(move |k| {
+                    let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+                    (a.min(b), a.max(b))
+                })
+            })
+            .collect();
+        e.sort_unstable();
+        e.dedup();
+        e
+    }
+
     /// Boundary edges (used by one triangle only), as `(a, b)` in the triangle's winding.
     pub fn boundary_edges(&self) -> Vec<(usize, usize)> {
         let mut count = std::collections::BTreeMap::new();

@@ -6,7 +6,6 @@ use image::{Rgb, RgbImage};
 use nalgebra::Matrix3;
 
 use super::expressions::Expressions;
-use super::head_pose::head_pivot;
 use super::model::FaceMesh;
 use super::render::{FaceRenderer, Texture};
 use super::skin::procedural_face_texture;
@@ -15,19 +14,16 @@ use crate::geometry::Vec3;
 use crate::tracking::camera::Camera;
 use crate::tracking::raster::{draw_triangles, project_vertices, RasterTarget};
 
-/// A camera looking at `mesh`'s pivot from `yaw_deg` (0: in front), framing the face in a
+/// A camera looking at `mesh`'s centroid from `yaw_deg` (0: in front), framing the face in a
 /// `width × height` image.
 pub fn preview_camera(mesh: &FaceMesh, yaw_deg: f64, width: u32, height: u32) -> Camera {
-    let pivot = head_pivot(mesh);
     let centre = mesh.centroid();
     let (lo, hi) = mesh.bounds();
     let size = (hi - lo).x.max((hi - lo).y);
     let yaw = yaw_deg.to_radians();
     let distance = 0.5;
-    let eye = pivot
-        + distance * Vec3::new(yaw.sin(), 0.0, yaw.cos())
-        + Vec3::new(0.0, centre.y - pivot.y, 0.0);
-    let target = Vec3::new(pivot.x, centre.y, pivot.z);
+    let eye = centre + distance * Vec3::new(yaw.sin(), 0.0, yaw.cos());
+    let target = centre;
     let f = (target - eye).normalize();
     let right = -Vec3::y().cross(&f).normalize();
     let down = f.cross(&right);

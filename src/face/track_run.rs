@@ -217,7 +217,7 @@ pub fn write_face_track_outputs(
             .filter_map(|&n| rig.index_of(n))
             .collect();
         let pivot = super::head_pose::head_pivot(&seq.model);
-        let edges = unique_edges(&seq.model.triangles);
+        let edges = seq.model.edges();
         let (mut values, mut deformed, mut posed) = (vec![0.0; rig.len()], Vec::new(), Vec::new());
         for row in result.rows.iter().step_by(overlay_every) {
             let mut img = image::open(seq.image_path(0, row.frame))
@@ -243,22 +243,6 @@ pub fn write_face_track_outputs(
         }
     }
     Ok(files)
-}
-
-/// The edges of a triangle list, each once.
-fn unique_edges(triangles: &[[u32; 3]]) -> Vec<(usize, usize)> {
-    let mut e: Vec<(usize, usize)> = triangles
-        .iter()
-        .flat_map(|t| {
-            (0..3).map(move |k| {
-                let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
-                (a.min(b), a.max(b))
-            })
-        })
-        .collect();
-    e.sort_unstable();
-    e.dedup();
-    e
 }
 
 /// Draws the posed mesh's edges (thin, green) on `img`.

@@ -9,9 +9,11 @@ use rhai::{Dynamic, Engine, Map, INT};
 use super::convert::{rt_err, RResult};
 use super::register;
 use super::tracking_sequence::{number, whole};
+use crate::face::adapt::AdaptOptions;
 use crate::face::blendshapes::write_arkit_glb;
 use crate::face::expressions::Expressions;
 use crate::face::fap::FapRig;
+use crate::face::fit_run::fit_folder;
 use crate::face::model::FaceMesh;
 use crate::face::muscles::MuscleRig;
 use crate::face::preview::expression_image;
@@ -158,6 +160,74 @@ fn arkit(path: &str) -> RResult<()> {
     write_arkit_glb(Path::new(path), &mesh, &faps, &muscles).map_err(rt_err)
 }
 
+fn fit(images: &str, out: &str, m: &Map) -> RResult<Map> {
+    let mut options = AdaptOptions::default();
+    let (mut pts_dir, mut texture_size) = (None, 1024usize);
+    for (k, v) in m {
+        let k = k.as_str();
+        match k {
+            "pts" => pts_dir = Some(v.to_string()),
+            "texture_size" => texture_size = whole(v, k)? as usize,
+            "support_fraction" => options.support_fraction = number(v, k)?,
+            "rbf_smoothing" => options.rbf_smoothing = number(v, k)?,
+            "contour_iterations" => options.contour_iterations = whole(v, k)? as usize,
+            other => {
+                return Err(rt_err(format!(
+                    "face_fit: unknown option `{other}` (pts, texture_size, support_fraction, \
+                     rbf_smoothing, contour_iterations)"
+                )))
+            }
+        }
+    }
+    let (_, report) = fit_folder(
+        Path::new(images),
+        pts_dir.as_deref().map(Path::new),
+        Path::new(out),
+        &options,
+        texture_size,
+    )
+    .map_err(rt_err)?;
+    let mut r = Map::new();
+    r.insert(
+        "images".into(),
+        Dynamic::from_int(report.names.len() as INT),
+    );
+    r.insert(
+        "landmark_err_iod_pct".into(),
+        Dynamic::from_float(report.mean_error_iod_pct()),
+    );
+    r.insert(
+        "errors".into(),
+        Dynamic::from_array(
+            report
+                .errors_iod_pct
+                .iter()
+                .map(|&e| Dynamic::from_float(e))
+                .collect(),
+        ),
+    );
+    r.insert(
+        "names".into(),
+        Dynamic::from_array(
+            report
+                .names
+                .iter()
+                .map(|n| Dynamic::from(n.clone()))
+                .collect(),
+        ),
+    );
+    r.insert(
+        "texture_coverage".into(),
+        Dynamic::from_float(report.texture_coverage),
+    );
+    r.insert(
+        "mean_abs_change_mm".into(),
+        Dynamic::from_float(report.mean_abs_change * 1000.0),
+    );
+    r.insert("files".into(), Dynamic::from_int(report.files.len() as INT));
+    Ok(r)
+}
+
 /// Registers the face functions.
 pub fn register(engine: &mut Engine) {
     register!(
@@ -229,5 +299,23 @@ values, e.g. #{ smile: 1.0 } or #{ fap_3: 800 }.",
 named morph targets (`extras.targetNames`, the names Blender, Unity and three.js read), made
 from the FAPs and muscles, and beside it a CSV of each shape's largest displacement.",
         |path: &str| arkit(path)
+    );
+    register!(
+        engine,
+        "face_fit",
+        ["images: String", "out: String", "options: Map", "Map"],
+        "Adapts the generic face (MediaPipe canonical mesh) to the photos of folder `images` that
+have a `.pts` file of the same stem (68 iBUG landmarks, 300-W convention): each photo's
+camera (pose, focal length) and the 3D characteristic points together, then the jaw-line
+contour in every photo, then an RBF deformation of the whole mesh (mouth and eye regions
+kept apart), then the cameras again. Writes under `out`: `face.obj`/`.mtl`/`.png` and
+`face.glb` textured from all photos, `overlay_NAME.png` per photo (the fitted mesh, given
+landmarks red, the model's green), `render_front/left/right.png`, `error_map.png` (adapted
+vs generic face: green outside, red inside) and `fit.csv`. Options: `pts` (folder of the
+.pts files, default `images`), `texture_size` (1024), `support_fraction` (RBF support as a
+fraction of the face width), `rbf_smoothing`, `contour_iterations`. Returns #{images,
+landmark_err_iod_pct (mean over photos, % of the outer-eye-corner distance), errors,
+names, texture_coverage, mean_abs_change_mm, files}.",
+        |images: &str, out: &str, m: Map| fit(images, out, &m)
     );
 }
