@@ -96,7 +96,7 @@ fn other_scripts_run() {
         let name = p.file_stem().unwrap().to_str().unwrap().to_string();
         // the contact scripts run in tests/contact_scripts.rs, the garments in
         // tests/garment_scripts.rs, buckle_square in tests/buckling.rs and the tracking
-        // scripts in tests/tracking_track.rs, the face scripts in tests/face_track.rs,
+        // scripts in tests/tracking_track.rs, the face scripts in tests/face_track.rs and tests/face_fit.rs,
         // with their checks
         if [
             "hang",
@@ -116,6 +116,8 @@ fn other_scripts_run() {
             "track_body",
             "make_face_sequence",
             "face_track",
+            "face_fit",
+            "face_fit_steps",
         ]
         .contains(&name.as_str())
         {

@@ -5,7 +5,8 @@
 //!
 //! A folder holds photos (`.png`, `.jpg`) and, for each photo to use, a `.pts` file of the same
 //! stem (68 iBUG points, 300-W convention), in the same folder or in a separate one. Photos
-//! without landmarks are skipped; a folder without any pair is an error naming it.
+//! without landmarks are skipped; a `.pts` file without its photo, or a folder without any
+//! pair, is an error naming it.
 
 use std::path::{Path, PathBuf};
 
@@ -78,6 +79,26 @@ pub fn load_photos(images: &Path, pts_dir: Option<&Path>) -> Result<PhotoSet, Fa
             .push(View::new(source, landmarks, img.width(), img.height()));
         set.images.push(img);
         set.names.push(stem);
+    }
+    // a landmark file without its photo is a mistake worth naming
+    let mut orphans: Vec<PathBuf> = std::fs::read_dir(pts_dir)
+        .map_err(|e| FaceError::io(pts_dir, e))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "pts"))
+        .filter(|p| {
+            let stem = p.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
+            !set.names.iter().any(|n| n == stem)
+        })
+        .collect();
+    orphans.sort();
+    if let Some(p) = orphans.first() {
+        return Err(FaceError::io(
+            p,
+            format!(
+                "no photo of this stem (.png, .jpg or .jpeg) in {}",
+                images.display()
+            ),
+        ));
     }
     if set.views.is_empty() {
         return Err(FaceError::Landmarks {

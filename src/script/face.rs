@@ -10,10 +10,11 @@ use super::convert::{rt_err, RResult};
 use super::register;
 use super::tracking_sequence::{number, whole};
 use crate::face::adapt::AdaptOptions;
+use crate::face::adapt::FaceFit;
 use crate::face::blendshapes::write_arkit_glb;
 use crate::face::expressions::Expressions;
 use crate::face::fap::FapRig;
-use crate::face::fit_run::fit_folder;
+use crate::face::fit_run::{fit_folder, load_photos, write_fit_outputs, PhotoSet};
 use crate::face::model::FaceMesh;
 use crate::face::muscles::MuscleRig;
 use crate::face::preview::expression_image;
@@ -228,6 +229,37 @@ fn fit(images: &str, out: &str, m: &Map) -> RResult<Map> {
     Ok(r)
 }
 
+/// A face adaptation driven step by step from a script (every step can be undone).
+#[derive(Clone)]
+pub struct FaceFitSession {
+    fit: FaceFit,
+    photos: PhotoSet,
+}
+
+fn start(images: &str, m: &Map) -> RResult<FaceFitSession> {
+    let mut pts_dir = None;
+    for (k, v) in m {
+        match k.as_str() {
+            "pts" => pts_dir = Some(v.to_string()),
+            other => {
+                return Err(rt_err(format!(
+                    "face_fit_start: unknown option `{other}` (pts)"
+                )))
+            }
+        }
+    }
+    let photos =
+        load_photos(Path::new(images), pts_dir.as_deref().map(Path::new)).map_err(rt_err)?;
+    let generic = FaceMesh::mediapipe().map_err(rt_err)?;
+    let fit = FaceFit::new(&generic, &photos.views, &AdaptOptions::default()).map_err(rt_err)?;
+    Ok(FaceFitSession { fit, photos })
+}
+
+fn session_error(s: &FaceFitSession) -> f64 {
+    let n = s.photos.views.len();
+    (0..n).map(|v| s.fit.landmark_error_iod_pct(v)).sum::<f64>() / n.max(1) as f64
+}
+
 /// Registers the face functions.
 pub fn register(engine: &mut Engine) {
     register!(
@@ -317,5 +349,106 @@ fraction of the face width), `rbf_smoothing`, `contour_iterations`. Returns #{im
 landmark_err_iod_pct (mean over photos, % of the outer-eye-corner distance), errors,
 names, texture_coverage, mean_abs_change_mm, files}.",
         |images: &str, out: &str, m: Map| fit(images, out, &m)
+    );
+    engine.register_type_with_name::<FaceFitSession>("FaceFit");
+    register!(
+        engine,
+        "face_fit_start",
+        ["images: String", "options: Map", "FaceFit"],
+        "Starts a step-by-step adaptation of the generic face to the photos of `images` that have
+a `.pts` file of the same stem (option `pts`: the folder of the .pts files). Then call
+`calibrate`, `adapt_contours`, `deform` and `refine_cameras` in that order; `undo` returns to
+the state before the last step; `write` writes the outputs as `face_fit` does.",
+        |images: &str, m: Map| start(images, &m)
+    );
+    register!(
+        engine,
+        "calibrate",
+        ["fit: FaceFit", "()"],
+        "Step 1: each photo's camera (pose and focal length) and the 3D characteristic points,
+estimated together (views that see a point frontally count more; central points stay on
+the symmetry plane).",
+        |s: &mut FaceFitSession| s.fit.calibrate_and_reconstruct().map_err(rt_err)
+    );
+    register!(
+        engine,
+        "adapt_contours",
+        ["fit: FaceFit", "()"],
+        "Step 2: the jaw-line landmarks of every photo are matched to the mesh's silhouette in
+that view (sliding contour points) and the mesh follows.",
+        |s: &mut FaceFitSession| s.fit.adapt_contours().map_err(rt_err)
+    );
+    register!(
+        engine,
+        "deform",
+        ["fit: FaceFit", "()"],
+        "Step 3: the whole mesh follows the reconstructed points by RBF interpolation (the
+compactly supported kernel of the seed's eq. 9), upper and lower lips and eyelids kept apart.",
+        |s: &mut FaceFitSession| s.fit.deform().map_err(rt_err)
+    );
+    register!(
+        engine,
+        "refine_cameras",
+        ["fit: FaceFit", "()"],
+        "Step 4: the cameras refined on the deformed mesh.",
+        |s: &mut FaceFitSession| s.fit.refine_cameras().map_err(rt_err)
+    );
+    register!(
+        engine,
+        "undo",
+        ["fit: FaceFit", "String"],
+        "Returns the adaptation to its state before the last step (the backup made by that
+step) and returns the step's name; an error when there is nothing to undo.",
+        |s: &mut FaceFitSession| -> RResult<String> {
+            s.fit.undo().map(str::to_string).map_err(rt_err)
+        }
+    );
+    register!(
+        engine,
+        "history",
+        ["fit: FaceFit", "Array"],
+        "Names of the steps done so far that `undo` can take back, oldest first.",
+        |s: &mut FaceFitSession| -> rhai::Array {
+            s.fit
+                .history_steps()
+                .into_iter()
+                .map(|n| Dynamic::from(n.to_string()))
+                .collect()
+        }
+    );
+    register!(
+        engine,
+        "landmark_error",
+        ["fit: FaceFit", "f64"],
+        "Mean landmark error over the photos, % of each photo's inter-ocular distance (outer
+eye corners); NaN before `calibrate`.",
+        |s: &mut FaceFitSession| session_error(s)
+    );
+    register!(
+        engine,
+        "write",
+        ["fit: FaceFit", "out: String", "Map"],
+        "Writes the outputs of the adaptation in its current state under `out` (as `face_fit`:
+textured OBJ and glb, overlays, renders, error map, fit.csv); returns #{images,
+landmark_err_iod_pct, texture_coverage, files}.",
+        |s: &mut FaceFitSession, out: &str| -> RResult<Map> {
+            let report =
+                write_fit_outputs(&s.fit, &s.photos, Path::new(out), 1024).map_err(rt_err)?;
+            let mut r = Map::new();
+            r.insert(
+                "images".into(),
+                Dynamic::from_int(report.names.len() as INT),
+            );
+            r.insert(
+                "landmark_err_iod_pct".into(),
+                Dynamic::from_float(report.mean_error_iod_pct()),
+            );
+            r.insert(
+                "texture_coverage".into(),
+                Dynamic::from_float(report.texture_coverage),
+            );
+            r.insert("files".into(), Dynamic::from_int(report.files.len() as INT));
+            Ok(r)
+        }
     );
 }
