@@ -35,15 +35,15 @@ fn main() {
     eprintln!("samples {}", tr.sample_count());
     let t = std::time::Instant::now();
     let mut sum = 0.0;
-    for k in 0..seq.info.frames {
+    for (k, truth_k) in truth.iter().enumerate().take(seq.info.frames) {
         let imgs = seq.frame_images(k).unwrap();
         let r = tr.track(&imgs).unwrap();
-        let e = r.pose.angle_to(&truth[k].pose).to_degrees();
-        let te = (r.pose.translation - truth[k].pose.translation).norm() * 1000.0;
+        let e = r.pose.angle_to(&truth_k.pose).to_degrees();
+        let te = (r.pose.translation - truth_k.pose.translation).norm() * 1000.0;
         let fe: Vec<String> = r
             .faps
             .iter()
-            .zip(&truth[k].faps)
+            .zip(&truth_k.faps)
             .zip(&seq.info.fap_ranges)
             .map(|((a, b), (lo, hi))| format!("{:.0}", 100.0 * (a - b).abs() / (hi - lo)))
             .collect();
@@ -51,23 +51,23 @@ fn main() {
         if let Ok(j) = std::env::var("PROFILE") {
             let j: usize = j.parse().unwrap();
             let (lo, hi) = seq.info.fap_ranges[j];
-            let mut f = truth[k].faps.clone();
+            let mut f = truth_k.faps.clone();
             let mut line = String::new();
             for s in 0..=8 {
                 f[j] = lo + (hi - lo) * s as f64 / 8.0;
                 line.push_str(&format!(
                     " {:.0}:{:.1}",
                     f[j],
-                    tr.cost_at(&truth[k].pose, &f, 0)
+                    tr.cost_at(&truth_k.pose, &f, 0)
                 ));
             }
-            println!("    profile fap {j} true {:.0}:{line}", truth[k].faps[j]);
+            println!("    profile fap {j} true {:.0}:{line}", truth_k.faps[j]);
         }
         if std::env::var("FAPDUMP").is_ok() {
             println!(
                 "    est {:?}\n    tru {:?}",
                 r.faps.iter().map(|v| v.round()).collect::<Vec<_>>(),
-                truth[k].faps.iter().map(|v| v.round()).collect::<Vec<_>>()
+                truth_k.faps.iter().map(|v| v.round()).collect::<Vec<_>>()
             );
         }
         println!(

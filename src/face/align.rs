@@ -42,7 +42,7 @@ pub fn similarity_align(from: &[Vec3], to: &[Vec3]) -> Option<Similarity> {
     }
     cov /= n as f64;
     var /= n as f64;
-    if !(var > 0.0) {
+    if var.is_nan() || var <= 0.0 {
         return None;
     }
     let svd = SVD::new(cov, true, true);

@@ -273,7 +273,7 @@ pub fn make_face_sequence(
         options.distance,
         pivot,
     );
-    let mut rng = SplitMix64::new(options.seed ^ 0xBAC6_0D);
+    let mut rng = SplitMix64::new(options.seed ^ 0x00BA_C60D);
     let backgrounds = backgrounds(options, &mut rng)?;
 
     let mkdir = |p: &Path| std::fs::create_dir_all(p).map_err(|e| FaceError::io(p, e));
