@@ -40,16 +40,7 @@ pub struct PhotoSet {
 /// point count, points outside the photo, no usable pair.
 pub fn load_photos(images: &Path, pts_dir: Option<&Path>) -> Result<PhotoSet, FaceError> {
     let pts_dir = pts_dir.unwrap_or(images);
-    let mut photos: Vec<PathBuf> = std::fs::read_dir(images)
-        .map_err(|e| FaceError::io(images, e))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            p.extension()
-                .and_then(|e| e.to_str())
-                .is_some_and(|e| matches!(e.to_ascii_lowercase().as_str(), "png" | "jpg" | "jpeg"))
-        })
-        .collect();
-    photos.sort();
+    let photos = crate::geometry::photo_files(images).map_err(|e| FaceError::io(images, e))?;
     let mut set = PhotoSet {
         names: Vec::new(),
         images: Vec::new(),

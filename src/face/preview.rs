@@ -3,7 +3,6 @@
 //! expression gallery of the sliders and FAPs on the generic face.
 
 use image::{Rgb, RgbImage};
-use nalgebra::Matrix3;
 
 use super::expressions::Expressions;
 use super::model::FaceMesh;
@@ -23,22 +22,8 @@ pub fn preview_camera(mesh: &FaceMesh, yaw_deg: f64, width: u32, height: u32) ->
     let yaw = yaw_deg.to_radians();
     let distance = 0.5;
     let eye = centre + distance * Vec3::new(yaw.sin(), 0.0, yaw.cos());
-    let target = centre;
-    let f = (target - eye).normalize();
-    let right = -Vec3::y().cross(&f).normalize();
-    let down = f.cross(&right);
-    let rotation = Matrix3::from_rows(&[right.transpose(), down.transpose(), f.transpose()]);
-    let focal = 0.8 * height.min(width) as f64 * (distance - 0.0) / (size * 1.15);
-    Camera::new(
-        focal,
-        focal,
-        (width as f64 - 1.0) / 2.0,
-        (height as f64 - 1.0) / 2.0,
-        rotation,
-        -(rotation * eye),
-        width,
-        height,
-    )
+    let focal = 0.8 * height.min(width) as f64 * distance / (size * 1.15);
+    Camera::looking_at(eye, centre, focal, width, height)
 }
 
 /// `positions` (on `mesh`'s triangles and texture coordinates) rendered with `texture` and

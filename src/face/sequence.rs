@@ -35,7 +35,6 @@ use super::skin::procedural_face_texture;
 use super::FaceError;
 use crate::geometry::{write_obj, SplitMix64, Vec3};
 use crate::tracking::camera::Camera;
-use nalgebra::Matrix3;
 
 /// Settings of [`make_face_sequence`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -173,22 +172,7 @@ pub fn face_cameras(
                 (-30.0 + 60.0 * k as f64 / (n - 1) as f64).to_radians()
             };
             let eye = pivot + distance * Vec3::new(yaw.sin(), 0.05, yaw.cos());
-            let f = (pivot - eye).normalize();
-            let right = Vec3::y().cross(&f).normalize();
-            let right = -right; // image x towards the subject's left seen from the front
-            let down = f.cross(&right);
-            let rotation =
-                Matrix3::from_rows(&[right.transpose(), down.transpose(), f.transpose()]);
-            Camera::new(
-                focal,
-                focal,
-                (width as f64 - 1.0) / 2.0,
-                (height as f64 - 1.0) / 2.0,
-                rotation,
-                -(rotation * eye),
-                width,
-                height,
-            )
+            Camera::looking_at(eye, pivot, focal, width, height)
         })
         .collect()
 }
@@ -366,16 +350,7 @@ fn backgrounds(
         return Ok(vec![grey(); options.cameras]);
     };
     let dir = Path::new(dir);
-    let mut photos: Vec<_> = std::fs::read_dir(dir)
-        .map_err(|e| FaceError::io(dir, e))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            p.extension()
-                .and_then(|e| e.to_str())
-                .is_some_and(|e| matches!(e.to_ascii_lowercase().as_str(), "jpg" | "jpeg" | "png"))
-        })
-        .collect();
-    photos.sort();
+    let photos = crate::geometry::photo_files(dir).map_err(|e| FaceError::io(dir, e))?;
     if photos.is_empty() {
         return Err(FaceError::io(
             dir,

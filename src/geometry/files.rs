@@ -1,5 +1,6 @@
 //! Helpers shared by the mesh and picture writers: atomic file writing (temporary file in the
-//! same folder, then rename) and the checks a mesh must pass before it is written.
+//! same folder, then rename), the checks a mesh must pass before it is written, and the list of
+//! the photos of a folder.
 
 use std::fs;
 use std::io::{self, BufWriter, Write};
@@ -7,6 +8,20 @@ use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use super::{GeometryError, Vec3};
+
+/// The photos of `dir` (`.png`, `.jpg`, `.jpeg`, any case), sorted by path.
+pub fn photo_files(dir: &Path) -> io::Result<Vec<std::path::PathBuf>> {
+    let mut photos: Vec<std::path::PathBuf> = fs::read_dir(dir)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.extension()
+                .and_then(|e| e.to_str())
+                .is_some_and(|e| matches!(e.to_ascii_lowercase().as_str(), "jpg" | "jpeg" | "png"))
+        })
+        .collect();
+    photos.sort();
+    Ok(photos)
+}
 
 /// Writes `path` through `write`, atomically: parent folders are created, the bytes go to a
 /// temporary file in the same folder which is renamed over `path` only once complete, so a

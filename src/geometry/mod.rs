@@ -12,6 +12,7 @@ pub mod random;
 pub mod topology;
 
 pub use error::GeometryError;
+pub use files::photo_files;
 pub use gltf::write_glb;
 pub use grid::grid_mesh;
 pub use mesh::TriMesh;

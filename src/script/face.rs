@@ -139,15 +139,21 @@ fn track(seq_dir: &str, out: &str, m: &Map) -> RResult<Map> {
     Ok(r)
 }
 
+/// Creates the folder of `path`.
+fn parent_dir(path: &str) -> RResult<()> {
+    if let Some(dir) = Path::new(path).parent() {
+        std::fs::create_dir_all(dir).map_err(|e| rt_err(format!("{}: {e}", dir.display())))?;
+    }
+    Ok(())
+}
+
 fn expression_png(path: &str, m: &Map, yaw_deg: f64) -> RResult<()> {
     let values = m
         .iter()
         .map(|(k, v)| Ok((k.to_string(), number(v, k)?)))
         .collect::<RResult<Vec<_>>>()?;
     let img = expression_image(&values, 512, yaw_deg).map_err(rt_err)?;
-    if let Some(dir) = Path::new(path).parent() {
-        std::fs::create_dir_all(dir).map_err(|e| rt_err(format!("{}: {e}", dir.display())))?;
-    }
+    parent_dir(path)?;
     img.save(path).map_err(|e| rt_err(format!("{path}: {e}")))
 }
 
@@ -155,9 +161,7 @@ fn arkit(path: &str) -> RResult<()> {
     let mesh = FaceMesh::mediapipe().map_err(rt_err)?;
     let faps = FapRig::new(&mesh).map_err(rt_err)?;
     let muscles = MuscleRig::mediapipe(&mesh).map_err(rt_err)?;
-    if let Some(dir) = Path::new(path).parent() {
-        std::fs::create_dir_all(dir).map_err(|e| rt_err(format!("{}: {e}", dir.display())))?;
-    }
+    parent_dir(path)?;
     write_arkit_glb(Path::new(path), &mesh, &faps, &muscles).map_err(rt_err)
 }
 

@@ -262,6 +262,32 @@ impl Camera {
         }
     }
 
+    /// A camera without distortion at `eye` looking at `target`, the world's +y up in the image
+    /// (image x towards +x when looking along −z), square pixels of focal length `focal`,
+    /// principal point at the image centre.
+    pub fn looking_at(
+        eye: Vector3<f64>,
+        target: Vector3<f64>,
+        focal: f64,
+        width: u32,
+        height: u32,
+    ) -> Camera {
+        let f = (target - eye).normalize();
+        let right = f.cross(&Vector3::y()).normalize();
+        let down = f.cross(&right);
+        let rotation = Matrix3::from_rows(&[right.transpose(), down.transpose(), f.transpose()]);
+        Camera::new(
+            focal,
+            focal,
+            (width as f64 - 1.0) / 2.0,
+            (height as f64 - 1.0) / 2.0,
+            rotation,
+            -(rotation * eye),
+            width,
+            height,
+        )
+    }
+
     /// The intrinsic matrix `K = [[fx, 0, cx], [0, fy, cy], [0, 0, 1]]`.
     pub fn k_matrix(&self) -> Matrix3<f64> {
         Matrix3::new(self.fx, 0.0, self.cx, 0.0, self.fy, self.cy, 0.0, 0.0, 1.0)

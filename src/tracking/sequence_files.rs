@@ -505,16 +505,7 @@ pub fn read_joints_csv(path: &Path) -> Result<Vec<(usize, f64, JointFrame)>, Seq
 
 /// Photos of `dir` (`jpg`, `jpeg`, `png`), sorted by name.
 pub(crate) fn list_photos(dir: &Path) -> Result<Vec<PathBuf>, SequenceError> {
-    let mut photos: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map_err(io_err(dir))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            p.extension()
-                .and_then(|e| e.to_str())
-                .is_some_and(|e| matches!(e.to_ascii_lowercase().as_str(), "jpg" | "jpeg" | "png"))
-        })
-        .collect();
-    photos.sort();
+    let photos = crate::geometry::photo_files(dir).map_err(io_err(dir))?;
     if photos.is_empty() {
         return Err(SequenceError::Missing {
             path: dir.to_path_buf(),
