@@ -12,19 +12,17 @@ use std::path::{Component, Path};
 
 use gltf_json::accessor::{ComponentType, Type};
 use gltf_json::buffer::Target;
-use gltf_json::image::MimeType;
 use gltf_json::material::{PbrBaseColorFactor, PbrMetallicRoughness, StrengthFactor};
-use gltf_json::mesh::{Mode, Primitive, Semantic};
-use gltf_json::texture::{Info, MagFilter, MinFilter, Sampler, WrappingMode};
-use gltf_json::validation::Checked::Valid;
-use gltf_json::{Accessor, Image, Material, Texture};
+use gltf_json::texture::{Info, MinFilter};
+use gltf_json::{Accessor, Material};
 
 use super::error::FacadeError;
 use super::facade_mesh::{FacadeMesh, Surface};
 use super::labels::Class;
 use crate::geometry::files::write_atomic;
 use crate::geometry::gltf::{
-    f32_bounds, finish_glb, glb_accessor, glb_root, glb_view, linear_from_srgb,
+    f32_bounds, finish_glb, glb_accessor, glb_png_texture, glb_root, glb_triangles, glb_view,
+    linear_from_srgb,
 };
 use crate::geometry::GeometryError;
 
@@ -234,26 +232,7 @@ pub fn write_glb_textured(
 
     let texture = png.as_ref().map(|bytes| {
         let image_view = root.push(view(image_at, bytes.len() as u64, None));
-        let image = root.push(Image {
-            buffer_view: Some(image_view),
-            mime_type: Some(MimeType("image/png".into())),
-            uri: None,
-            extensions: None,
-            extras: Default::default(),
-        });
-        let sampler = root.push(Sampler {
-            mag_filter: Some(Valid(MagFilter::Linear)),
-            min_filter: Some(Valid(MinFilter::LinearMipmapLinear)),
-            wrap_s: Valid(WrappingMode::ClampToEdge),
-            wrap_t: Valid(WrappingMode::ClampToEdge),
-            ..Default::default()
-        });
-        root.push(Texture {
-            sampler: Some(sampler),
-            source: image,
-            extensions: None,
-            extras: Default::default(),
-        })
+        glb_png_texture(&mut root, image_view, MinFilter::LinearMipmapLinear)
     });
 
     let mut primitives = Vec::with_capacity(mesh.groups.len());
@@ -288,21 +267,14 @@ pub fn write_glb_textured(
             },
             ..Default::default()
         });
-        primitives.push(Primitive {
-            attributes: [
-                (Valid(Semantic::Positions), pos_acc),
-                (Valid(Semantic::Normals), nrm_acc),
-                (Valid(Semantic::TexCoords(0)), uv_acc),
-            ]
-            .into_iter()
-            .collect(),
-            extensions: None,
-            extras: Default::default(),
-            indices: Some(idx_acc),
-            material: Some(material),
-            mode: Valid(Mode::Triangles),
-            targets: None,
-        });
+        primitives.push(glb_triangles(
+            pos_acc,
+            nrm_acc,
+            Some(uv_acc),
+            idx_acc,
+            Some(material),
+            None,
+        ));
     }
     finish_glb(path, root, primitives, bin).map_err(|e| geometry_err(path, e))
 }

@@ -15,16 +15,18 @@ use std::path::Path;
 
 use gltf_json::accessor::{ComponentType, Type};
 use gltf_json::buffer::Target;
-use gltf_json::mesh::{Mode, MorphTarget, Primitive, Semantic};
-use gltf_json::validation::Checked::Valid;
-use gltf_json::{Accessor, Mesh, Node, Scene};
+use gltf_json::mesh::MorphTarget;
+use gltf_json::Accessor;
 
 use super::expressions::{combination, Slider};
 use super::fap::FapRig;
 use super::model::FaceMesh;
 use super::muscles::MuscleRig;
 use super::FaceError;
-use crate::geometry::gltf::{f32_bounds, glb_accessor, glb_root, glb_view};
+use crate::geometry::files::write_atomic;
+use crate::geometry::gltf::{
+    f32_bounds, finish_glb_morph, glb_accessor, glb_root, glb_triangles, glb_view,
+};
 use crate::geometry::Vec3;
 
 /// The 52 ARKit blendshape names, in Apple's documented order.
@@ -279,57 +281,9 @@ pub fn write_arkit_glb(
         ComponentType::U32,
         Type::Scalar,
     ));
-    let primitive = Primitive {
-        attributes: [
-            (Valid(Semantic::Positions), pos_acc),
-            (Valid(Semantic::Normals), nrm_acc),
-            (Valid(Semantic::TexCoords(0)), uv_acc),
-        ]
-        .into_iter()
-        .collect(),
-        extensions: None,
-        extras: Default::default(),
-        indices: Some(idx_acc),
-        material: None,
-        mode: Valid(Mode::Triangles),
-        targets: Some(targets),
-    };
-    let gmesh = root.push(Mesh {
-        extensions: None,
-        extras: Default::default(),
-        primitives: vec![primitive],
-        weights: Some(vec![0.0; shapes.len()]),
-    });
-    let node = root.push(Node {
-        mesh: Some(gmesh),
-        ..Default::default()
-    });
-    let scene = root.push(Scene {
-        extensions: None,
-        extras: Default::default(),
-        nodes: vec![node],
-    });
-    root.scene = Some(scene);
-    // gltf-json is built without its `extras` feature: add the target names to the JSON.
-    let mut json = serde_json::to_value(&root).map_err(|e| fail(format!("glTF JSON: {e}")))?;
+    let primitive = glb_triangles(pos_acc, nrm_acc, Some(uv_acc), idx_acc, None, Some(targets));
     let names: Vec<&str> = shapes.iter().map(|(s, _)| s.as_str()).collect();
-    json["meshes"][0]["extras"] = serde_json::json!({ "targetNames": names });
-    let mut json = serde_json::to_vec(&json).map_err(|e| fail(format!("glTF JSON: {e}")))?;
-    json.resize(json.len().next_multiple_of(4), b' ');
-    bin.resize(bin.len().next_multiple_of(4), 0);
-    let total = u32::try_from(28 + json.len() + bin.len())
-        .map_err(|_| fail("larger than the 4 GiB GLB limit".into()))?;
-    let mut glb = Vec::with_capacity(total as usize);
-    glb.extend_from_slice(b"glTF");
-    glb.extend_from_slice(&2u32.to_le_bytes());
-    glb.extend_from_slice(&total.to_le_bytes());
-    glb.extend_from_slice(&(json.len() as u32).to_le_bytes());
-    glb.extend_from_slice(&0x4E4F_534Au32.to_le_bytes());
-    glb.extend_from_slice(&json);
-    glb.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    glb.extend_from_slice(&0x004E_4942u32.to_le_bytes());
-    glb.extend_from_slice(&bin);
-    write_file(path, &glb)?;
+    finish_glb_morph(path, root, vec![primitive], &names, bin).map_err(|e| fail(e.to_string()))?;
     let mut csv = String::from("name,max_displacement_m,vertex\n");
     for (name, d) in &shapes {
         let (i, m) = d
@@ -339,26 +293,7 @@ pub fn write_arkit_glb(
             .fold((0, 0.0), |a, b| if b.1 > a.1 { b } else { a });
         csv.push_str(&format!("{name},{m:.6e},{i}\n"));
     }
-    write_file(&path.with_extension("csv"), csv.as_bytes())
-}
-
-/// Writes bytes to a temporary sibling, then renames it over `path` (parents created).
-fn write_file(path: &Path, bytes: &[u8]) -> Result<(), FaceError> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| FaceError::io(dir, e))?;
-    }
-    let name = path
-        .file_name()
-        .ok_or_else(|| FaceError::io(path, "not a file path"))?;
-    let mut tmp_name = name.to_os_string();
-    tmp_name.push(format!(".tmp{}", std::process::id()));
-    let tmp = path.with_file_name(tmp_name);
-    let result = std::fs::File::create(&tmp)
-        .and_then(|mut f| f.write_all(bytes).and_then(|_| f.sync_all()))
-        .and_then(|_| std::fs::rename(&tmp, path));
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(FaceError::io(path, e));
-    }
-    Ok(())
+    let csv_path = path.with_extension("csv");
+    write_atomic(&csv_path, |w: &mut dyn Write| w.write_all(csv.as_bytes()))
+        .map_err(|e| FaceError::io(&csv_path, e))
 }

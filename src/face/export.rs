@@ -19,17 +19,16 @@ use std::path::Path;
 
 use gltf_json::accessor::{ComponentType, Type};
 use gltf_json::buffer::Target;
-use gltf_json::image::MimeType;
 use gltf_json::material::{PbrBaseColorFactor, PbrMetallicRoughness, StrengthFactor};
-use gltf_json::mesh::{Mode, Primitive, Semantic};
-use gltf_json::texture::{Info, MagFilter, MinFilter, Sampler, WrappingMode};
-use gltf_json::validation::Checked::Valid;
-use gltf_json::{Accessor, Image, Material};
+use gltf_json::texture::{Info, MinFilter};
+use gltf_json::{Accessor, Material};
 
 use super::render::Texture;
 use super::{FaceError, FaceMesh};
 use crate::geometry::files::write_atomic;
-use crate::geometry::gltf::{f32_bounds, finish_glb, glb_accessor, glb_root, glb_view};
+use crate::geometry::gltf::{
+    f32_bounds, finish_glb, glb_accessor, glb_png_texture, glb_root, glb_triangles, glb_view,
+};
 use crate::geometry::GeometryError;
 
 /// Name of the material in the `.mtl` file and the OBJ's `usemtl`.
@@ -294,26 +293,7 @@ pub fn write_glb(path: &Path, mesh: &FaceMesh, texture: &Texture) -> Result<(), 
         ComponentType::U32,
         Type::Scalar,
     ));
-    let image = root.push(Image {
-        buffer_view: Some(png_view),
-        mime_type: Some(MimeType("image/png".into())),
-        uri: None,
-        extensions: None,
-        extras: Default::default(),
-    });
-    let sampler = root.push(Sampler {
-        mag_filter: Some(Valid(MagFilter::Linear)),
-        min_filter: Some(Valid(MinFilter::Linear)),
-        wrap_s: Valid(WrappingMode::ClampToEdge),
-        wrap_t: Valid(WrappingMode::ClampToEdge),
-        ..Default::default()
-    });
-    let texture_index = root.push(gltf_json::Texture {
-        sampler: Some(sampler),
-        source: image,
-        extensions: None,
-        extras: Default::default(),
-    });
+    let texture_index = glb_png_texture(&mut root, png_view, MinFilter::Linear);
     let material = root.push(Material {
         double_sided: true,
         pbr_metallic_roughness: PbrMetallicRoughness {
@@ -330,20 +310,13 @@ pub fn write_glb(path: &Path, mesh: &FaceMesh, texture: &Texture) -> Result<(), 
         },
         ..Default::default()
     });
-    let primitive = Primitive {
-        attributes: [
-            (Valid(Semantic::Positions), pos_acc),
-            (Valid(Semantic::Normals), nrm_acc),
-            (Valid(Semantic::TexCoords(0)), uv_acc),
-        ]
-        .into_iter()
-        .collect(),
-        extensions: None,
-        extras: Default::default(),
-        indices: Some(idx_acc),
-        material: Some(material),
-        mode: Valid(Mode::Triangles),
-        targets: None,
-    };
+    let primitive = glb_triangles(
+        pos_acc,
+        nrm_acc,
+        Some(uv_acc),
+        idx_acc,
+        Some(material),
+        None,
+    );
     finish_glb(path, root, vec![primitive], bin).map_err(|e| from_geometry(path, e))
 }

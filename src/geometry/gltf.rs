@@ -6,10 +6,12 @@ use std::path::Path;
 
 use gltf_json::accessor::{ComponentType, GenericComponentType, Type};
 use gltf_json::buffer::{Buffer, Target, View};
+use gltf_json::image::MimeType;
 use gltf_json::material::{PbrBaseColorFactor, PbrMetallicRoughness, StrengthFactor};
-use gltf_json::mesh::{Mode, Primitive, Semantic};
+use gltf_json::mesh::{Mode, MorphTarget, Primitive, Semantic};
+use gltf_json::texture::{MagFilter, MinFilter, Sampler, WrappingMode};
 use gltf_json::validation::{Checked::Valid, USize64};
-use gltf_json::{Accessor, Index, Material, Mesh, Node, Root, Scene};
+use gltf_json::{Accessor, Image, Index, Material, Mesh, Node, Root, Scene, Texture};
 
 use super::files::{check_mesh, write_atomic};
 use super::mesh::vertex_normals;
@@ -110,20 +112,7 @@ pub fn write_glb(
         },
         ..Default::default()
     });
-    let primitive = Primitive {
-        attributes: [
-            (Valid(Semantic::Positions), pos_acc),
-            (Valid(Semantic::Normals), nrm_acc),
-        ]
-        .into_iter()
-        .collect(),
-        extensions: None,
-        extras: Default::default(),
-        indices: Some(idx_acc),
-        material: Some(material),
-        mode: Valid(Mode::Triangles),
-        targets: None,
-    };
+    let primitive = glb_triangles(pos_acc, nrm_acc, None, idx_acc, Some(material), None);
     finish_glb(path, root, vec![primitive], bin)
 }
 
@@ -203,13 +192,85 @@ pub(crate) fn glb_accessor(
     }
 }
 
+/// A PNG image stored in `view`, sampled linearly (minification `min_filter`), clamped at the
+/// edges, as a texture.
+pub(crate) fn glb_png_texture(
+    root: &mut Root,
+    view: Index<View>,
+    min_filter: MinFilter,
+) -> Index<Texture> {
+    let image = root.push(Image {
+        buffer_view: Some(view),
+        mime_type: Some(MimeType("image/png".into())),
+        uri: None,
+        extensions: None,
+        extras: Default::default(),
+    });
+    let sampler = root.push(Sampler {
+        mag_filter: Some(Valid(MagFilter::Linear)),
+        min_filter: Some(Valid(min_filter)),
+        wrap_s: Valid(WrappingMode::ClampToEdge),
+        wrap_t: Valid(WrappingMode::ClampToEdge),
+        ..Default::default()
+    });
+    root.push(Texture {
+        sampler: Some(sampler),
+        source: image,
+        extensions: None,
+        extras: Default::default(),
+    })
+}
+
+/// A triangle-list primitive with positions, normals, optional texture coordinates, indices,
+/// an optional material and optional morph targets.
+pub(crate) fn glb_triangles(
+    positions: Index<Accessor>,
+    normals: Index<Accessor>,
+    uvs: Option<Index<Accessor>>,
+    indices: Index<Accessor>,
+    material: Option<Index<Material>>,
+    targets: Option<Vec<MorphTarget>>,
+) -> Primitive {
+    let mut attributes: std::collections::BTreeMap<_, _> = [
+        (Valid(Semantic::Positions), positions),
+        (Valid(Semantic::Normals), normals),
+    ]
+    .into_iter()
+    .collect();
+    if let Some(uv) = uvs {
+        attributes.insert(Valid(Semantic::TexCoords(0)), uv);
+    }
+    Primitive {
+        attributes,
+        extensions: None,
+        extras: Default::default(),
+        indices: Some(indices),
+        material,
+        mode: Valid(Mode::Triangles),
+        targets,
+    }
+}
+
 /// Completes a glTF document whose buffers, views, accessors and materials are in `root`:
 /// one mesh of `primitives`, one node, one scene; then writes it as binary glTF (JSON and BIN
 /// chunks padded to 4 bytes) atomically. Shared by every `.glb` writer.
 pub(crate) fn finish_glb(
     path: &Path,
+    root: Root,
+    primitives: Vec<Primitive>,
+    bin: Vec<u8>,
+) -> Result<(), GeometryError> {
+    finish_glb_morph(path, root, primitives, &[], bin)
+}
+
+/// [`finish_glb`] for a mesh with morph targets: the mesh's default weights are zeros and the
+/// targets' names go to `mesh.extras.targetNames` (the convention Blender, three.js and
+/// Unity read). With no names, exactly [`finish_glb`].
+pub(crate) fn finish_glb_morph(
+    path: &Path,
     mut root: Root,
     primitives: Vec<Primitive>,
+    target_names: &[&str],
     mut bin: Vec<u8>,
 ) -> Result<(), GeometryError> {
     let invalid = |m: String| GeometryError::Invalid(format!("{}: {m}", path.display()));
@@ -217,7 +278,7 @@ pub(crate) fn finish_glb(
         extensions: None,
         extras: Default::default(),
         primitives,
-        weights: None,
+        weights: (!target_names.is_empty()).then(|| vec![0.0; target_names.len()]),
     });
     let node = root.push(Node {
         mesh: Some(mesh),
@@ -229,8 +290,16 @@ pub(crate) fn finish_glb(
         nodes: vec![node],
     });
     root.scene = Some(scene);
-    let mut json =
-        gltf_json::serialize::to_vec(&root).map_err(|e| invalid(format!("glTF JSON: {e}")))?;
+    let mut json = if target_names.is_empty() {
+        gltf_json::serialize::to_vec(&root).map_err(|e| invalid(format!("glTF JSON: {e}")))?
+    } else {
+        // gltf-json is built without its `extras` feature: the names go into the JSON value
+        let mut value =
+            serde_json::to_value(&root).map_err(|e| invalid(format!("glTF JSON: {e}")))?;
+        value["meshes"][mesh.value()]["extras"] =
+            serde_json::json!({ "targetNames": target_names });
+        serde_json::to_vec(&value).map_err(|e| invalid(format!("glTF JSON: {e}")))?
+    };
     json.resize(json.len().next_multiple_of(4), b' ');
     bin.resize(bin.len().next_multiple_of(4), 0);
     let total = 12 + 8 + json.len() as u64 + 8 + bin.len() as u64;
