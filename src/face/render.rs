@@ -1,7 +1,7 @@
 //! Textured, z-buffered rendering of a face mesh through a [`Camera`], and the texture image.
 //!
 //! [`FaceRenderer::render`] reuses the tracker's rasterizer
-//! ([`draw_triangles`](crate::tracking::raster::draw_triangles)): texture coordinates travel
+//! ([`crate::tracking::raster::draw_triangles`]): texture coordinates travel
 //! as the interpolated "colour" of each vertex (affine in the image, which for a face's small
 //! triangles differs from perspective-correct interpolation by far less than a texel), then
 //! every covered pixel samples the [`Texture`] bilinearly. The result stays in the renderer's
