@@ -2,11 +2,16 @@
 //! silhouettes, camera + characteristic-point fit, the pipeline with undo, and the acceptance
 //! measurements on a known deformed face seen through synthetic cameras.
 //!
-//! The "true" face is the generic MediaPipe mesh under a smooth deformation (wider, longer nose
-//! pushed out, lower mouth, wider jaw, chin forward). Its 68 landmarks are projected through
-//! known cameras; the jaw landmarks are put on the true silhouette of each view; 0.5 px of
-//! seeded Gaussian noise is added. The adapted mesh is compared with the true one vertex by
-//! vertex after a similarity alignment (Umeyama, written here independently of the library).
+//! The "true" face is the generic MediaPipe mesh under a smooth identity change that is not a
+//! similarity (`true_face`: wider and flatter face, long narrow protruding nose, eyes apart and
+//! higher, lower wider mouth, wider jaw, chin forward, fuller cheeks, sloping forehead, shorter
+//! lower face): the undeformed generic mesh is 3.5 % of the face width from it, above both
+//! limits. Its 68 landmarks are projected through known cameras (640×480, f = 1000 px, 0.5 m);
+//! the jaw landmarks are put on the true silhouette of each view; 0.5 px of seeded Gaussian
+//! noise is added. The adapted mesh is compared with the true one vertex by vertex after a
+//! similarity alignment (Umeyama, written here independently of the library): ≤ 1.5 % of the
+//! face width and under half the generic's error with 3 views (frontal, ±40° yaw), ≤ 3 % and
+//! under the generic's with the frontal view alone.
 
 use emilion::face::adapt::{adapt, AdaptOptions, FaceFit};
 use emilion::face::contour::silhouette;
@@ -32,36 +37,77 @@ fn smoothstep(t: f64) -> f64 {
     t * t * (3.0 - 2.0 * t)
 }
 
-/// The known person: a smooth deformation of the generic face.
+/// Smooth ramp: 0 for `t ≤ 0`, then `t` once `t ≫ w` (C¹).
+fn ramp(t: f64, w: f64) -> f64 {
+    t.max(0.0) * smoothstep(t / w)
+}
+
+/// The known person: the generic face under a sum of smooth localized fields — an identity
+/// change far from a similarity (the generic mesh is 3.5 % of the face width from it, mean,
+/// after the best similarity).
 fn true_face(g: &FaceMesh) -> FaceMesh {
     let p = &g.positions;
-    let (bridge, tip, mouth, chin) = (p[168], p[4], (p[13] + p[14]) * 0.5, p[152]);
+    let lm = landmark_positions(g);
+    let normals = g.vertex_normals();
+    let mean = |r: std::ops::Range<usize>| lm[r.clone()].iter().sum::<Vec3>() / r.len() as f64;
+    let (bridge, tip, nose_base, chin) = (p[168], p[4], p[2], p[152]);
+    let mouth = (p[13] + p[14]) * 0.5;
+    let eyes = [mean(36..42), mean(42..48)];
+    let brow_y = mean(17..27).y;
+    let cheeks = [
+        Vec3::new(-0.046, -0.01, 0.036),
+        Vec3::new(0.046, -0.01, 0.036),
+    ];
     let mut out = g.clone();
-    for (q, o) in out.positions.iter_mut().zip(p) {
+    for ((q, o), n) in out.positions.iter_mut().zip(p).zip(&normals) {
         let mut d = Vec3::zeros();
-        // wider face
-        d.x += 0.08 * o.x;
-        // nose 15 % longer (downwards from the bridge), tip 5 mm out
-        let wn = gauss(o.x * o.x, 0.018) * smoothstep((bridge.y + 0.01 - o.y) / 0.02);
-        let wn = wn * smoothstep((o.y - (tip.y - 0.03)) / 0.02);
-        d.y -= 0.15 * (bridge.y - o.y).max(0.0) * wn;
-        d.z += 0.005 * gauss((o - tip).norm_squared(), 0.014);
-        // mouth 4 mm lower
-        d.y -= 0.004 * gauss(o.x * o.x / 1.5 + (o.y - mouth.y).powi(2), 0.016);
-        // wider jaw, below the mouth
-        d.x += 0.10 * o.x * smoothstep((mouth.y - o.y) / 0.04);
-        // chin 4 mm forward
-        d.z += 0.004 * gauss(o.x * o.x + (o.y - chin.y).powi(2), 0.02);
+        // face 15 % wider and 15 % flatter (depth measured from the cheek plane z = 3 cm)
+        d.x += 0.15 * o.x;
+        d.z -= 0.15 * (o.z - 0.03);
+        // long narrow nose: 30 % longer downwards from the bridge (fading out towards the
+        // mouth), 20 % narrower, tip 10 mm further out
+        let across = gauss(o.x * o.x, 0.012) * smoothstep((o.z - 0.035) / 0.015);
+        let above_mouth = smoothstep((o.y - mouth.y) / (tip.y - mouth.y));
+        d.y -= 0.30 * ramp(bridge.y - o.y, 0.01).min(bridge.y - tip.y) * across * above_mouth;
+        let nose_band = smoothstep((bridge.y + 0.01 - o.y) / 0.02) * above_mouth;
+        d.x -= 0.20 * o.x * gauss(o.x * o.x, 0.012) * nose_band;
+        d.z += 0.010 * gauss((o - tip).norm_squared(), 0.013);
+        // eyes 6 mm further apart and 3 mm higher
+        for (e, side) in eyes.iter().zip([-1.0, 1.0]) {
+            let w = gauss((o - e).norm_squared(), 0.012);
+            d.x += side * 0.003 * w;
+            d.y += 0.003 * w;
+        }
+        // mouth 8 mm lower and 13 % wider
+        let wm = gauss(o.x * o.x / 2.5 + (o.y - mouth.y).powi(2), 0.016);
+        d.y -= 0.008 * wm;
+        d.x += 0.13 * o.x * wm;
+        // jaw up to 20 % wider below the nose, chin 6 mm forward
+        d.x += 0.20 * o.x * smoothstep((nose_base.y - o.y) / 0.06);
+        d.z += 0.006 * gauss(o.x * o.x + (o.y - chin.y).powi(2), 0.02);
+        // fuller cheeks: 5 mm along the normal
+        for c in &cheeks {
+            d += n * (0.005 * gauss((o - c).norm_squared(), 0.02));
+        }
+        // forehead sloping back above the brows
+        d.z -= 0.30 * ramp(o.y - brow_y - 0.005, 0.02);
+        // lower face 6 % shorter (chin 4 mm up), forehead 12 % taller: about the same height
+        d.y += 0.06 * ramp(nose_base.y - o.y, 0.01) + 0.12 * ramp(o.y - brow_y, 0.01);
         *q = o + d;
     }
     out
 }
 
-/// A camera 0.5 m from the face, turned by `yaw_deg` about the vertical axis.
+/// A camera 0.5 m from the face, turned by `yaw_deg` about the vertical axis, slightly above.
 fn camera(yaw_deg: f64) -> Camera {
+    camera_at(yaw_deg, 0.05)
+}
+
+/// As [`camera`], its centre `elevation × 0.5 m` above the face's centre.
+fn camera_at(yaw_deg: f64, elevation: f64) -> Camera {
     let target = Vec3::new(0.0, 0.0, 0.03);
     let a = yaw_deg.to_radians();
-    let c = target + Vec3::new(a.sin(), 0.05, a.cos()) * 0.5;
+    let c = target + Vec3::new(a.sin(), elevation, a.cos()) * 0.5;
     let fwd = (target - c).normalize();
     let right = Vec3::new(0.0, -1.0, 0.0).cross(&fwd).normalize();
     let down = fwd.cross(&right);
@@ -139,6 +185,10 @@ fn acceptance_three_views() {
     let fit = adapt(&g, &v, &AdaptOptions::default()).unwrap();
     let err = aligned_error_pct(&fit.mesh, &truth);
     println!("3 views: mean vertex error {err:.3} % of face width (generic baseline {base:.3} %)");
+    assert!(
+        base > 3.0,
+        "the test face is too close to the generic one: {base} %"
+    );
     for k in 0..v.len() {
         let e = fit.landmark_error_iod_pct(k);
         println!(
@@ -181,15 +231,45 @@ fn acceptance_single_view() {
          rms {:.3} px",
         fit.rms_px[0]
     );
+    assert!(
+        base > 3.0,
+        "the test face is too close to the generic one: {base} %"
+    );
     assert!(err <= 3.0, "1-view error {err} % of face width");
-    // Not asserted: beating the generic mesh's vertex error. With one frontal view the depth
-    // changes of the true face (nose tip, chin) are unobservable and leak into the
-    // reconstruction; see the report. The characteristic points must beat the generic ones.
+    // One view cannot see depth (the flatter face, the nose tip and chin pushed out stay
+    // generic), but the changes across the line of sight must be recovered: the mesh and
+    // the characteristic points must beat the generic ones.
+    assert!(
+        err < base,
+        "1-view error {err} does not beat the generic {base}"
+    );
     assert!(
         pe < 0.9 * pb,
         "1-view points {pe} do not beat the generic {pb}"
     );
     assert!(e < 2.0, "landmark error {e} % IOD");
+}
+
+/// The pitch prior of the single-view fit (a camera about at face level) must not distort a
+/// face that is really seen from 11° above or below.
+#[test]
+fn single_view_of_a_tilted_head() {
+    let g = generic();
+    for elevation in [-0.2, 0.2] {
+        let mut rng = SplitMix64::new(13);
+        let landmarks = render(&g, &camera_at(0.0, elevation), 0.5, &mut rng);
+        let v = [View::new("tilted", landmarks, 640, 480)];
+        let fit = adapt(&g, &v, &AdaptOptions::default()).unwrap();
+        let err = aligned_error_pct(&fit.mesh, &g);
+        let e = fit.landmark_error_iod_pct(0);
+        println!(
+            "generic face seen {:.1}° from above: vertex error {err:.3} %, landmark error \
+             {e:.3} % IOD",
+            f64::atan(elevation).to_degrees()
+        );
+        assert!(err < 1.0, "{err}");
+        assert!(e < 1.0, "{e}");
+    }
 }
 
 #[test]
@@ -255,8 +335,8 @@ fn lower_lip_does_not_move_upper_lip() {
     }
     // left/right symmetric labels
     let mirror = g.mirror_map();
-    for v in 0..g.positions.len() {
-        let (a, b) = (regions.label(v), regions.label(mirror[v]));
+    for (v, &m) in mirror.iter().enumerate() {
+        let (a, b) = (regions.label(v), regions.label(m));
         let swapped = match a {
             Region::UpperLidLeft => Region::UpperLidRight,
             Region::UpperLidRight => Region::UpperLidLeft,

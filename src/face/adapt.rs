@@ -52,7 +52,7 @@ pub struct AdaptOptions {
     pub support_fraction: f64,
     /// RBF smoothing ([`super::rbf::Rbf::fit_smoothed`]): the reconstructed points carry noise
     /// and, with few views, depth errors; a little smoothing keeps the interpolant from
-    /// overshooting between them (0 interpolates exactly).
+    /// overshooting between them (0 interpolates exactly; default 0.01, see [`super::rbf`]).
     pub rbf_smoothing: f64,
     /// Matching–deformation rounds of the contour step.
     pub contour_iterations: usize,
@@ -68,7 +68,7 @@ impl Default for AdaptOptions {
         AdaptOptions {
             view_fit: ViewFitOptions::default(),
             support_fraction: DEFAULT_SUPPORT_FRACTION,
-            rbf_smoothing: 0.03,
+            rbf_smoothing: 0.01,
             contour_iterations: 5,
             contour_max_iod: 0.5,
             merge_radius: 0.004,
@@ -390,7 +390,7 @@ impl FaceFit {
             return f64::NAN;
         }
         let iod = inter_ocular_distance(&v.landmarks);
-        if !(iod > 0.0) {
+        if iod.is_nan() || iod <= 0.0 {
             return f64::NAN;
         }
         let pts = landmark_positions(&self.mesh);
