@@ -76,9 +76,13 @@ impl Texture {
             .map_err(|e| FaceError::io(path, e))
     }
 
-    /// Bilinear sample at texture coordinates `(u, v)` (`v` up), clamped to the edge.
+    /// Bilinear sample at texture coordinates `(u, v)` (`v` up), clamped to the edge; black
+    /// for an empty texture.
     #[inline]
     pub fn sample(&self, u: f32, v: f32) -> [f32; 3] {
+        if self.width == 0 || self.height == 0 || self.rgb.len() < self.width * self.height {
+            return [0.0; 3];
+        }
         let x = (u * self.width as f32 - 0.5).clamp(0.0, (self.width - 1) as f32);
         let y = ((1.0 - v) * self.height as f32 - 0.5).clamp(0.0, (self.height - 1) as f32);
         let (x0, y0) = (x as usize, y as usize);

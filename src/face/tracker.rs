@@ -208,6 +208,22 @@ impl FaceTracker {
                 "at least one camera is needed",
             ));
         }
+        let (w0, h0) = (cameras[0].width, cameras[0].height);
+        if let Some(k) = cameras.iter().position(|c| (c.width, c.height) != (w0, h0)) {
+            return Err(FaceError::parameter(
+                "cameras",
+                format!(
+                    "camera {k} has images of {}×{}, camera 0 of {w0}×{h0}: all must be the same size",
+                    cameras[k].width, cameras[k].height
+                ),
+            ));
+        }
+        if w0 < 16 || h0 < 16 {
+            return Err(FaceError::parameter(
+                "cameras",
+                format!("images of {w0}×{h0} are too small to track in (at least 16×16)"),
+            ));
+        }
         if fap_values.len() != faps.len() {
             return Err(FaceError::parameter(
                 "fap_values",
