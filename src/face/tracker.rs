@@ -52,6 +52,8 @@ pub struct FaceTrackerOptions {
     pub layers: usize,
     /// Initial annealing spread, as a fraction of each FAP's range. Default 0.12.
     pub fap_spread: f64,
+    /// Gauss–Newton iterations polishing the FAP values after the annealing. Default 3.
+    pub fap_refine: usize,
     /// Fraction of the last frame-to-frame motion added to the prediction. Default 0.7.
     pub prediction: f64,
     /// Scale of the robust error (grey levels). Default 20.
@@ -69,6 +71,7 @@ impl Default for FaceTrackerOptions {
             particles: 24,
             layers: 4,
             fap_spread: 0.12,
+            fap_refine: 3,
             prediction: 0.7,
             robust_sigma: 20.0,
             seed: 7,
@@ -84,6 +87,12 @@ impl FaceTrackerOptions {
             return Err(p(
                 "sample_grid",
                 format!("must be 16..=1024, got {}", self.sample_grid),
+            ));
+        }
+        if self.fap_refine > 100 {
+            return Err(p(
+                "fap_refine",
+                format!("must be 0..=100, got {}", self.fap_refine),
             ));
         }
         if self.gn_coarse + self.gn_fine == 0 || self.gn_coarse > 100 || self.gn_fine > 100 {
@@ -156,6 +165,10 @@ pub struct FaceTracker {
     colours: [Vec<f32>; 2],
     /// Groups of tracked FAPs searched together.
     groups: Vec<FapGroup>,
+    /// Displacement of every vertex per unit of each tracked FAP (the rig is linear).
+    unit_fields: Vec<Vec<Vec3>>,
+    /// Samples moved by some tracked FAP.
+    fap_active: Vec<usize>,
     pivot: Vec3,
     pose: HeadPose,
     faps: Vec<f64>,
@@ -249,12 +262,20 @@ impl FaceTracker {
         // FAPs whose zones overlap are searched together; each group's cost reads only the
         // samples its FAPs move
         let mut moves: Vec<Vec<bool>> = Vec::new();
+        let mut unit_fields: Vec<Vec<Vec3>> = Vec::new();
         let mut probe = vec![0.0; rig.len()];
         let mut moved = Vec::new();
         for &i in &tracked {
             probe[i] = 1.0;
             rig.apply(&mesh.positions, &probe, &mut moved);
             probe[i] = 0.0;
+            unit_fields.push(
+                moved
+                    .iter()
+                    .zip(&mesh.positions)
+                    .map(|(a, b)| a - b)
+                    .collect(),
+            );
             moves.push(
                 moved
                     .iter()
@@ -276,6 +297,13 @@ impl FaceTracker {
                 }
             }
         }
+        let mut any_moving = vec![false; mesh.vertex_count()];
+        for m in &moves {
+            for (a, x) in any_moving.iter_mut().zip(m) {
+                *a |= *x;
+            }
+        }
+        let fap_active = samples.touching(&mesh.triangles, &any_moving);
         let mut groups = Vec::new();
         for g in 0..tracked.len() {
             let members: Vec<usize> = (0..tracked.len()).filter(|&k| group_of[k] == g).collect();
@@ -310,6 +338,8 @@ impl FaceTracker {
             ranges,
             colours: [Vec::new(), Vec::new()],
             groups,
+            unit_fields,
+            fap_active,
             samples,
             pose,
             faps: values,
@@ -574,6 +604,100 @@ impl FaceTracker {
         }
     }
 
+    /// Gauss–Newton (Levenberg-damped) polish of the tracked FAP values after the annealing,
+    /// all together, at `level`: the rig is linear, so a sample's motion per FAP unit is the
+    /// barycentric mix of its triangle's unit fields, turned by the head rotation.
+    fn refine_faps(&mut self, level: usize, iterations: usize) {
+        let n = self.tracked.len();
+        if n == 0 || iterations == 0 {
+            return;
+        }
+        let s2 = self.options.robust_sigma.powi(2);
+        let mut lambda = 1e-3;
+        self.pose_samples();
+        let mut current = self.rigid_cost(level).0;
+        let mut h = nalgebra::DMatrix::<f64>::zeros(n, n);
+        let mut b = nalgebra::DVector::<f64>::zeros(n);
+        let mut j = nalgebra::DVector::<f64>::zeros(n);
+        for _ in 0..iterations {
+            h.fill(0.0);
+            b.fill(0.0);
+            let rot = *self.pose.rotation.matrix();
+            for v in &self.views {
+                let cam = &v.cam[level];
+                let rt = cam.rotation.transpose();
+                for &s in &self.fap_active {
+                    let c = self.colours[level][s];
+                    let wv = v.vis[s] as f64;
+                    if wv <= 0.0 || !c.is_finite() {
+                        continue;
+                    }
+                    let p = self.sample_pos[s];
+                    let pc = cam.to_camera_frame(&p);
+                    if pc.z <= 0.0 {
+                        continue;
+                    }
+                    let (u, w) = (cam.fx * pc.x / pc.z + cam.cx, cam.fy * pc.y / pc.z + cam.cy);
+                    let Some((i, ix, iy)) = v.img[level].sample(u, w) else {
+                        continue;
+                    };
+                    let g = v.gain;
+                    let r = g * i as f64 - c as f64;
+                    let (ix, iy, z) = (g * ix as f64, g * iy as f64, pc.z);
+                    let d_pc = Vec3::new(
+                        ix * cam.fx / z,
+                        iy * cam.fy / z,
+                        -(ix * cam.fx * pc.x + iy * cam.fy * pc.y) / (z * z),
+                    );
+                    let a = rot.transpose() * (rt * d_pc);
+                    let t = self.mesh.triangles[self.samples.triangle[s] as usize];
+                    let bc = self.samples.bary[s];
+                    for (k, field) in self.unit_fields.iter().enumerate() {
+                        let d = field[t[0] as usize] * bc[0]
+                            + field[t[1] as usize] * bc[1]
+                            + field[t[2] as usize] * bc[2];
+                        j[k] = a.dot(&d);
+                    }
+                    let q = s2 + r * r;
+                    let wr = wv * s2 * s2 / (q * q);
+                    h.ger(wr, &j, &j, 1.0);
+                    b.axpy(wr * r, &j, 1.0);
+                }
+            }
+            let saved: Vec<f64> = self.tracked.iter().map(|&i| self.faps[i]).collect();
+            let mut improved = false;
+            for _ in 0..4 {
+                let mut hd = h.clone();
+                for k in 0..n {
+                    hd[(k, k)] += lambda * h[(k, k)].max(1e-12) + 1e-12;
+                }
+                let Some(delta) = hd.cholesky().map(|c| c.solve(&(-&b))) else {
+                    lambda *= 10.0;
+                    continue;
+                };
+                for (k, (&i, (lo, hi))) in self.tracked.iter().zip(&self.ranges).enumerate() {
+                    self.faps[i] = (saved[k] + delta[k]).clamp(*lo, *hi);
+                }
+                self.pose_samples();
+                let c = self.rigid_cost(level).0;
+                if c < current {
+                    current = c;
+                    lambda = (lambda / 3.0).max(1e-6);
+                    improved = true;
+                    break;
+                }
+                lambda *= 10.0;
+                for (k, &i) in self.tracked.iter().enumerate() {
+                    self.faps[i] = saved[k];
+                }
+            }
+            if !improved {
+                self.pose_samples();
+                break;
+            }
+        }
+    }
+
     /// Simulated annealing of the tracked FAP values, group after group.
     fn anneal_faps(&mut self, rng: &mut SplitMix64) {
         for g in 0..self.groups.len() {
@@ -712,6 +836,7 @@ impl FaceTracker {
             self.gauss_newton(0, self.options.gn_fine);
             lap(2, &mut times);
             self.anneal_faps(&mut rng);
+            self.refine_faps(0, self.options.fap_refine);
             lap(3, &mut times);
             self.update_visibility();
             lap(1, &mut times);

@@ -99,14 +99,15 @@ fn track(seq_dir: &str, out: &str, m: &Map) -> RResult<Map> {
             "particles" => o.particles = whole(v, k)? as usize,
             "layers" => o.layers = whole(v, k)? as usize,
             "fap_spread" => o.fap_spread = number(v, k)?,
+            "fap_refine" => o.fap_refine = whole(v, k)? as usize,
             "prediction" => o.prediction = number(v, k)?,
             "robust_sigma" => o.robust_sigma = number(v, k)?,
             "seed" => o.seed = whole(v, k)?,
             other => {
                 return Err(rt_err(format!(
                     "face_track: unknown option `{other}` (frames, overlay_every, sample_grid, \
-                     gn_coarse, gn_fine, particles, layers, fap_spread, prediction, \
-                     robust_sigma, seed)"
+                     gn_coarse, gn_fine, particles, layers, fap_spread, fap_refine, \
+                     prediction, robust_sigma, seed)"
                 )))
             }
         }
@@ -291,7 +292,8 @@ and FAPs): the model is textured from the first frame, then each frame's pose is
 Gauss–Newton on the photometric error and its FAP values by simulated annealing. Writes
 `tracked.csv`, `errors.csv` and `summary.json` (with ground truth) and `overlay/NNNN.png`
 under `out`. Options: `frames`, `overlay_every` (1; 0: none), `sample_grid`, `gn_coarse`,
-`gn_fine`, `particles`, `layers`, `fap_spread`, `prediction`, `robust_sigma`, `seed`.
+`gn_fine`, `particles`, `layers`, `fap_spread`, `fap_refine` (Gauss–Newton iterations
+polishing the FAPs after the annealing), `prediction`, `robust_sigma`, `seed`.
 Returns #{frames, pose_err_deg, pose_err_max_deg, fap_err, fap_err_max (fractions of each
 FAP's range; () without ground truth), fps, files}.",
         |seq: &str, out: &str, m: Map| track(seq, out, &m)
