@@ -16,7 +16,9 @@
 //!
 //! Per frame: prediction (damped constant velocity), Gauss–Newton with Levenberg damping on a
 //! half-resolution image then at full resolution, annealing of the FAP values (coarse layers
-//! first), a last Gauss–Newton pass. Deterministic: one seeded generator per frame, costs
+//! first; FAPs whose zones overlap searched together), a few Gauss–Newton steps on all FAP
+//! values (the rig is linear, so their Jacobian is the image gradient times the turned unit
+//! fields), a last Gauss–Newton pass on the pose. Deterministic: one seeded generator per frame, costs
 //! pure, reductions in a fixed order.
 
 use std::cell::RefCell;
