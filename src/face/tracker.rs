@@ -143,6 +143,29 @@ struct FapGroup {
     active: Vec<usize>,
 }
 
+/// The residual `g · I(π(p)) − c` of a sample at world point `p` in view `v` (pyramid
+/// `level`), and the gradient of `g · I(π(p))` with respect to `p` in world axes (image
+/// gradient × projection, distortion ignored); `None` behind the camera or off the image.
+#[inline]
+fn residual_and_gradient(v: &View, level: usize, p: &Vec3, c: f32) -> Option<(f64, Vec3)> {
+    let cam = &v.cam[level];
+    let pc = cam.to_camera_frame(p);
+    if pc.z <= 0.0 {
+        return None;
+    }
+    let (u, w) = (cam.fx * pc.x / pc.z + cam.cx, cam.fy * pc.y / pc.z + cam.cy);
+    let (i, ix, iy) = v.img[level].sample(u, w)?;
+    let g = v.gain;
+    let r = g * i as f64 - c as f64;
+    let (ix, iy, z) = (g * ix as f64, g * iy as f64, pc.z);
+    let d_pc = Vec3::new(
+        ix * cam.fx / z,
+        iy * cam.fy / z,
+        -(ix * cam.fx * pc.x + iy * cam.fy * pc.y) / (z * z),
+    );
+    Some((r, cam.rotation.transpose() * d_pc))
+}
+
 /// Per-thread buffers of the annealing cost.
 #[derive(Default)]
 struct CostScratch {
@@ -537,32 +560,15 @@ impl FaceTracker {
             let mut b = Vector6::<f64>::zeros();
             let centre = self.pivot + self.pose.translation;
             for v in &self.views {
-                let cam = &v.cam[level];
-                let rt = cam.rotation.transpose();
                 for (s, p) in self.sample_pos.iter().enumerate() {
                     let c = self.colours[level][s];
                     let wv = v.vis[s] as f64;
                     if wv <= 0.0 || !c.is_finite() {
                         continue;
                     }
-                    let pc = cam.to_camera_frame(p);
-                    if pc.z <= 0.0 {
-                        continue;
-                    }
-                    let (u, w) = (cam.fx * pc.x / pc.z + cam.cx, cam.fy * pc.y / pc.z + cam.cy);
-                    let Some((i, ix, iy)) = v.img[level].sample(u, w) else {
+                    let Some((r, a)) = residual_and_gradient(v, level, p, c) else {
                         continue;
                     };
-                    let g = v.gain;
-                    let r = g * i as f64 - c as f64;
-                    let (ix, iy) = (g * ix as f64, g * iy as f64);
-                    let z = pc.z;
-                    let d_pc = Vec3::new(
-                        ix * cam.fx / z,
-                        iy * cam.fy / z,
-                        -(ix * cam.fx * pc.x + iy * cam.fy * pc.y) / (z * z),
-                    );
-                    let a = rt * d_pc;
                     let jw = (p - centre).cross(&a);
                     let j = Vector6::new(jw.x, jw.y, jw.z, a.x, a.y, a.z);
                     // IRLS weight of Geman–McClure
@@ -626,32 +632,18 @@ impl FaceTracker {
             b.fill(0.0);
             let rot = *self.pose.rotation.matrix();
             for v in &self.views {
-                let cam = &v.cam[level];
-                let rt = cam.rotation.transpose();
                 for &s in &self.fap_active {
                     let c = self.colours[level][s];
                     let wv = v.vis[s] as f64;
                     if wv <= 0.0 || !c.is_finite() {
                         continue;
                     }
-                    let p = self.sample_pos[s];
-                    let pc = cam.to_camera_frame(&p);
-                    if pc.z <= 0.0 {
-                        continue;
-                    }
-                    let (u, w) = (cam.fx * pc.x / pc.z + cam.cx, cam.fy * pc.y / pc.z + cam.cy);
-                    let Some((i, ix, iy)) = v.img[level].sample(u, w) else {
+                    let Some((r, a)) = residual_and_gradient(v, level, &self.sample_pos[s], c)
+                    else {
                         continue;
                     };
-                    let g = v.gain;
-                    let r = g * i as f64 - c as f64;
-                    let (ix, iy, z) = (g * ix as f64, g * iy as f64, pc.z);
-                    let d_pc = Vec3::new(
-                        ix * cam.fx / z,
-                        iy * cam.fy / z,
-                        -(ix * cam.fx * pc.x + iy * cam.fy * pc.y) / (z * z),
-                    );
-                    let a = rot.transpose() * (rt * d_pc);
+                    // the gradient in the head's (model) axes
+                    let a = rot.transpose() * a;
                     let t = self.mesh.triangles[self.samples.triangle[s] as usize];
                     let bc = self.samples.bary[s];
                     for (k, field) in self.unit_fields.iter().enumerate() {
