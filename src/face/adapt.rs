@@ -123,16 +123,7 @@ impl FaceFit {
     ) -> Result<FaceFit, FaceError> {
         validate_views(views)?;
         let regions = FaceRegions::mediapipe(generic)?;
-        let positive = |name: &str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(FaceError::parameter(
-                    name,
-                    format!("must be finite and positive, got {v}"),
-                ))
-            }
-        };
+        let positive = FaceError::require_positive;
         positive("support_fraction", options.support_fraction)?;
         positive("contour_max_iod", options.contour_max_iod)?;
         positive("merge_radius", options.merge_radius)?;

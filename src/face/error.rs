@@ -53,6 +53,18 @@ impl FaceError {
         }
     }
 
+    /// `Ok` when `value` is finite and positive, else a parameter error naming `name`.
+    pub fn require_positive(name: &str, value: f64) -> Result<(), FaceError> {
+        if value.is_finite() && value > 0.0 {
+            Ok(())
+        } else {
+            Err(FaceError::parameter(
+                name,
+                format!("must be finite and positive, got {value}"),
+            ))
+        }
+    }
+
     /// A parameter error.
     pub fn parameter(name: &str, message: impl Into<String>) -> Self {
         FaceError::Parameter {

@@ -497,16 +497,7 @@ pub fn fit_views(
         ));
     }
     generic.validate("generic mesh")?;
-    let positive = |name: &str, v: f64| {
-        if v.is_finite() && v > 0.0 {
-            Ok(())
-        } else {
-            Err(FaceError::parameter(
-                name,
-                format!("must be finite and positive, got {v}"),
-            ))
-        }
-    };
+    let positive = FaceError::require_positive;
     positive("pixel_sigma", options.pixel_sigma)?;
     positive("prior_sigma", options.prior_sigma)?;
     positive("symmetry_sigma", options.symmetry_sigma)?;
