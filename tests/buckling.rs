@@ -272,6 +272,36 @@ fn flat_pushed_square_stays_compressed_without_a_model_and_buckles_with_compress
 }
 
 #[test]
+fn flat_triangle_mesh_pushed_from_one_border_is_released_by_compression_release() {
+    // the same square as a triangle mesh of irregular triangles (hinges, no grid lines),
+    // perfectly flat: without a model it stays flat and compressed until round-off lets it
+    // snap out of its plane late in the push
+    let (l, dir) = buckle_square("mesh_flat", &[("imperfection", "0.0"), ("mesh", "true")]);
+    for x in &l {
+        eprintln!("{x}");
+    }
+    let (none, rel) = (&l[0], &l[2]);
+    assert!(rel.contains(" release:"));
+    let springs = |x: &String| {
+        let s = &x[x.find('/').unwrap() + 1..];
+        s[..s.find(' ').unwrap()].parse::<f64>().unwrap()
+    };
+    assert!(springs(rel) > 5000.0, "{rel}");
+    // compression release: at most 1 % of the springs compressed by more than 1 %, wrinkles,
+    // and far less spring energy over the push than without a model
+    assert!(
+        field(rel, "compressed >1%:") / springs(rel) <= 0.01,
+        "{rel}"
+    );
+    assert!(field(rel, "half-waves") >= 2.0, "{rel}");
+    assert!(
+        field(rel, "mean over the run") < 0.25 * field(none, "mean over the run"),
+        "{none}\n{rel}"
+    );
+    assert!(dir.join("mesh_energy.png").exists() && dir.join("mesh_release_24.png").exists());
+}
+
+#[test]
 fn cloth_pushed_along_a_cylinder_is_released_by_compression_release() {
     let (l, dir) = run_script("buckle_cylinder", "cylinder", &[]);
     for x in &l {
@@ -284,10 +314,11 @@ fn cloth_pushed_along_a_cylinder_is_released_by_compression_release() {
         assert_eq!(field(x, "inside"), 0.0, "{x}");
     }
     // compression release: at most 1 % of the springs compressed by more than 1 %, less
-    // spring energy at the end than without a model
+    // spring energy at rest than without a model (the mean over the resting frames: contact
+    // and friction keep the last frames moving)
     assert!(field(rel, "compressed >1%:") / 3280.0 <= 0.01, "{rel}");
     assert!(
-        field(rel, "elastic") < field(none, "elastic"),
+        field(rel, "resting mean") < field(none, "resting mean"),
         "{none}\n{rel}"
     );
     assert!(dir.join("energy.png").exists() && dir.join("release_24.png").exists());

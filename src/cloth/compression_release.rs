@@ -1,9 +1,12 @@
 //! The compression-release buckling model of the seed report (§5.4.4.1.2, Chen & Gagalowicz):
-//! cloth is not left compressed. Each step, the most compressed stretch springs of a grid cloth
-//! are found; the particle at the spring's end is sent to where its three springs (two along the
-//! compression, one across) all have their rest length again — an intersection of three
-//! spheres — and held there for a few steps through the solver's constraint filter (S, z), so
-//! the rest of the cloth follows by the dynamics. Of the two intersections, the one clear of
+//! cloth is not left compressed. Each step, the most compressed stretch springs are found; the
+//! particle at the spring's end is sent to where its three springs (two along the compression,
+//! one across) all have their rest length again — an intersection of three spheres — and held
+//! there for a few steps through the solver's constraint filter (S, z), so the rest of the
+//! cloth follows by the dynamics. On a grid the three are its line neighbours and the nearer
+//! neighbour across; on a triangle mesh, the spring's other end, the neighbour most nearly
+//! opposite it in the pattern, and the most compressed neighbour roughly across (within 60° of
+//! perpendicular). Of the two intersections, the one clear of
 //! the collision bodies (by the contact distance), then the nearer, then the more curved is
 //! chosen; a seeded random draw breaks the remaining ties (a flat cloth buckles up or down at
 //! random, reproducibly for one seed). Particles already in contact are not released.
@@ -77,14 +80,21 @@ pub fn curvature3(p1: &Vec3, p2: &Vec3, p3: &Vec3) -> f64 {
     2.0 * c.acos() / (l1 + l2)
 }
 
-/// The model's state: grid neighbours and rest lengths, and who is held where.
+/// The model's state: neighbours and rest lengths, and who is held where.
 #[derive(Debug, Clone)]
 pub struct CompressionRelease {
     options: ReleaseOptions,
+    /// Grid size (0 × 0 for a triangle mesh).
     nx: usize,
     ny: usize,
-    /// Rest spacing along x (warp) and y (weft).
+    /// Rest spacing along x (warp) and y (weft) of a grid.
     rest: (f64, f64),
+    /// A triangle mesh's neighbours by stretch springs: particle `m`'s are
+    /// `adj[adj_ptr[m]..adj_ptr[m + 1]]` (neighbour, rest length); empty on a grid.
+    adj_ptr: Vec<usize>,
+    adj: Vec<(usize, f64)>,
+    /// Rest (pattern) coordinates of a triangle mesh's particles.
+    pattern: Vec<[f64; 2]>,
     /// Stretch springs (a, b, rest).
     springs: Vec<(usize, usize, f64)>,
     /// Held particles: (particle, destination, steps left).
@@ -99,37 +109,76 @@ pub struct CompressionRelease {
 }
 
 impl CompressionRelease {
-    /// The model for a grid cloth; `None` for other meshes (not supported yet).
-    pub fn new(model: &ClothModel, options: ReleaseOptions) -> Option<Self> {
-        let (nx, ny) = model.grid?;
-        let r = &model.mesh.rest;
-        let rest = (r[1][0] - r[0][0], r[nx][1] - r[0][1]);
-        let springs = model
+    /// The model for `model`'s cloth, a grid or any triangle mesh.
+    pub fn new(model: &ClothModel, options: ReleaseOptions) -> Self {
+        let n = model.particle_count();
+        let springs: Vec<(usize, usize, f64)> = model
             .springs
             .iter()
             .filter(|s| matches!(s.kind, SpringKind::Stretch { .. }))
             .map(|s| (s.a, s.b, s.rest))
             .collect();
-        Some(CompressionRelease {
+        let ((nx, ny), rest, adj_ptr, adj, pattern) = match model.grid {
+            Some((nx, ny)) => {
+                let r = &model.mesh.rest;
+                (
+                    (nx, ny),
+                    (r[1][0] - r[0][0], r[nx][1] - r[0][1]),
+                    Vec::new(),
+                    Vec::new(),
+                    Vec::new(),
+                )
+            }
+            None => {
+                let mut lists = vec![Vec::new(); n];
+                for &(a, b, r) in &springs {
+                    lists[a].push((b, r));
+                    lists[b].push((a, r));
+                }
+                let mut ptr = vec![0];
+                let mut adj = Vec::new();
+                for mut l in lists {
+                    l.sort_by_key(|e| e.0);
+                    adj.extend(l);
+                    ptr.push(adj.len());
+                }
+                ((0, 0), (0.0, 0.0), ptr, adj, model.mesh.rest.clone())
+            }
+        };
+        CompressionRelease {
             options,
             nx,
             ny,
             rest,
+            adj_ptr,
+            adj,
+            pattern,
             springs,
             held: Vec::new(),
-            busy: vec![false; nx * ny],
+            busy: vec![false; n],
             order: Vec::new(),
             rng: crate::geometry::SplitMix64::new(options.seed),
             releases: 0,
-        })
+        }
+    }
+
+    fn is_grid(&self) -> bool {
+        self.adj_ptr.is_empty()
     }
 
     fn random_bit(&mut self) -> bool {
         self.rng.bit()
     }
 
-    /// Marks particle `m` and its eight grid neighbours busy.
+    /// Marks particle `m` and its neighbours busy (on a grid, all eight around it).
     fn occupy(&mut self, m: usize) {
+        if !self.is_grid() {
+            self.busy[m] = true;
+            for k in self.adj_ptr[m]..self.adj_ptr[m + 1] {
+                self.busy[self.adj[k].0] = true;
+            }
+            return;
+        }
         let (i, j) = (m / self.nx, m % self.nx);
         for di in -1i64..=1 {
             for dj in -1i64..=1 {
@@ -187,7 +236,70 @@ impl CompressionRelease {
             (false, false) => return None,
         };
         let c = [x[m - along], x[m + along], x[side]];
-        let (qp, qm) = three_spheres(c, [r_along, r_along, r_across])?;
+        self.choose(x[m], c, [r_along, r_along, r_across], obstacles)
+    }
+
+    /// On a triangle mesh, the destination that releases particle `m`'s spring to `partner`:
+    /// three spheres around the partner, the neighbour most nearly opposite it in the pattern
+    /// (at least 120° away) and the most compressed neighbour within 60° of perpendicular;
+    /// `None` at a border without such neighbours.
+    fn mesh_destination(
+        &mut self,
+        x: &[Vec3],
+        m: usize,
+        partner: usize,
+        obstacles: Obstacles<'_>,
+    ) -> Option<Vec3> {
+        let pm = self.pattern[m];
+        let unit = |k: usize| {
+            let (du, dv) = (self.pattern[k][0] - pm[0], self.pattern[k][1] - pm[1]);
+            let l = (du * du + dv * dv).sqrt();
+            (du / l, dv / l)
+        };
+        let ring = &self.adj[self.adj_ptr[m]..self.adj_ptr[m + 1]];
+        let along = unit(partner);
+        let cos = |k: usize| {
+            let d = unit(k);
+            d.0 * along.0 + d.1 * along.1
+        };
+        let r_partner = ring.iter().find(|e| e.0 == partner)?.1;
+        // most nearly opposite (ties: lower index, the ring is sorted)
+        let mut opposite: Option<(usize, f64, f64)> = None;
+        // most compressed across (ties: lower index)
+        let mut across: Option<(usize, f64, f64)> = None;
+        for &(k, r) in ring {
+            if k == partner {
+                continue;
+            }
+            let c = cos(k);
+            if c <= -0.5 && opposite.is_none_or(|o| c < o.2) {
+                opposite = Some((k, r, c));
+            }
+            let ratio = (x[k] - x[m]).norm() / r;
+            if c.abs() <= 0.5 && across.is_none_or(|a| ratio < a.2) {
+                across = Some((k, r, ratio));
+            }
+        }
+        let ((o, ro, _), (a, ra, _)) = (opposite?, across?);
+        self.choose(
+            x[m],
+            [x[partner], x[o], x[a]],
+            [r_partner, ro, ra],
+            obstacles,
+        )
+    }
+
+    /// Of the two points at distances `r` from `c` (the first two along the compression), the
+    /// one clear of the obstacles, then the nearer to `at`, then the more curved, then a seeded
+    /// random one; `None` without an intersection or when both are blocked.
+    fn choose(
+        &mut self,
+        at: Vec3,
+        c: [Vec3; 3],
+        r: [f64; 3],
+        obstacles: Obstacles<'_>,
+    ) -> Option<Vec3> {
+        let (qp, qm) = three_spheres(c, r)?;
         // first by collision: never into a body
         match (obstacles.is_clear(&qp), obstacles.is_clear(&qm)) {
             (true, false) => return Some(qp),
@@ -195,8 +307,8 @@ impl CompressionRelease {
             (false, false) => return None,
             (true, true) => {}
         }
-        let (dp, dm) = ((qp - x[m]).norm(), (qm - x[m]).norm());
-        let tol = 1e-9 * r_along;
+        let (dp, dm) = ((qp - at).norm(), (qm - at).norm());
+        let tol = 1e-9 * r[0];
         if (dp - dm).abs() > tol {
             return Some(if dp < dm { qp } else { qm });
         }
@@ -243,12 +355,17 @@ impl ContactHook for CompressionRelease {
         let order = std::mem::take(&mut self.order);
         for &(_, k) in &order {
             let (a, b, _) = self.springs[k];
-            let along = if b - a == 1 { 1 } else { self.nx };
-            for m in [b, a] {
+            for (m, partner) in [(b, a), (a, b)] {
                 if self.busy[m] || !matches!(filter.kind[m], ParticleFilter::Free) {
                     continue;
                 }
-                if let Some(q) = self.destination(x, m, along, obstacles) {
+                let dest = if self.is_grid() {
+                    let along = if b - a == 1 { 1 } else { self.nx };
+                    self.destination(x, m, along, obstacles)
+                } else {
+                    self.mesh_destination(x, m, partner, obstacles)
+                };
+                if let Some(q) = dest {
                     filter.kind[m] = ParticleFilter::Fixed { target: q };
                     filter.any = true;
                     self.held
@@ -313,7 +430,7 @@ mod tests {
             seed,
             ..Default::default()
         };
-        let mut cr = CompressionRelease::new(&model, options).unwrap();
+        let mut cr = CompressionRelease::new(&model, options);
         let x = model.mesh.positions.clone();
         let mut filter = Filter::new(x.len());
         cr.constrain(&x, &x, 0.0, 0.01, &mut filter, obstacles);
@@ -325,6 +442,51 @@ mod tests {
                 _ => None,
             })
             .collect()
+    }
+
+    #[test]
+    fn a_compressed_triangle_mesh_releases_out_of_its_plane() {
+        use crate::cloth::FabricParameters;
+        let mesh = crate::garment::patch::rectangle_mesh(0.2, 0.1, 0.02).unwrap();
+        let mut model = ClothModel::from_mesh(mesh, FabricParameters::default()).unwrap();
+        assert!(model.grid.is_none());
+        model.prestrain(-0.2, 0.0);
+        let x = model.mesh.positions.clone();
+        let (mut up, mut down) = (0, 0);
+        for seed in 0..8 {
+            let options = ReleaseOptions {
+                seed,
+                ..Default::default()
+            };
+            let mut cr = CompressionRelease::new(&model, options);
+            let mut filter = Filter::new(x.len());
+            cr.constrain(&x, &x, 0.0, 0.01, &mut filter, Obstacles::none());
+            assert!(cr.releases > 0);
+            for (m, k) in filter.kind.iter().enumerate() {
+                let ParticleFilter::Fixed { target } = k else {
+                    continue;
+                };
+                // off the plane, and the spring to the compressed partner back at rest length
+                assert!(target.z.abs() > 1e-3, "{target}");
+                let back_at_rest = model.springs.iter().any(|s| {
+                    let other = if s.a == m {
+                        s.b
+                    } else if s.b == m {
+                        s.a
+                    } else {
+                        return false;
+                    };
+                    ((x[other] - target).norm() - s.rest).abs() < 1e-9 * s.rest
+                });
+                assert!(back_at_rest);
+                if target.z > 0.0 {
+                    up += 1;
+                } else {
+                    down += 1;
+                }
+            }
+        }
+        assert!(up > 0 && down > 0, "{up} up, {down} down");
     }
 
     #[test]

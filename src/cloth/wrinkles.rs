@@ -98,6 +98,55 @@ pub fn wrinkles_along(x: &[Vec3], line: &[usize], up: Vec3, threshold: f64) -> W
     }
 }
 
+/// Elastic energy of a cloth split by what stores it (J).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct EnergyParts {
+    /// Warp and weft stretch springs (and seam threads).
+    pub stretch: f64,
+    /// Shear (shear springs and shear cells).
+    pub shear: f64,
+    /// Bending lines and hinges.
+    pub bending: f64,
+    /// Choi–Ko's buckled interlaced connections.
+    pub flexion: f64,
+}
+
+impl EnergyParts {
+    /// The sum of the parts.
+    pub fn total(&self) -> f64 {
+        self.stretch + self.shear + self.bending + self.flexion
+    }
+}
+
+/// The elastic energy of `model` at positions `x`, element by element (elastic part of the
+/// laws: friction states are not included).
+pub fn energy_parts(model: &ClothModel, x: &[Vec3]) -> EnergyParts {
+    let law = &*model.law;
+    let mut e = EnergyParts::default();
+    for s in &model.springs {
+        let w = s.eval(law, &x[s.a], &x[s.b]).energy;
+        match s.kind {
+            SpringKind::Stretch { .. } | SpringKind::Seam { .. } => e.stretch += w,
+            SpringKind::Shear => e.shear += w,
+            SpringKind::Flexion { .. } => e.flexion += w,
+        }
+    }
+    for q in &model.shear_quads {
+        e.shear += q.area * law.shear(q.measure(x).gamma).2;
+    }
+    for b in &model.bend_lines {
+        let kappa = b.geometry(x).qn.norm();
+        e.bending += b.area * law.bending(b.dir, kappa).2;
+    }
+    for h in &model.hinges {
+        if let Some((theta, _)) = h.angle_and_gradient(x) {
+            let kappa = theta.abs() * h.edge / h.area;
+            e.bending += h.area * h.law(law, kappa).2;
+        }
+    }
+    e
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -118,5 +167,36 @@ mod tests {
         assert!((w.amplitude - 0.005).abs() < 1e-6);
         // ripples below the threshold are no wrinkles
         assert_eq!(wrinkles_along(&x, &line, Vec3::z(), 0.01).half_waves, 0);
+    }
+
+    #[test]
+    fn energy_parts_add_up_to_the_assembled_energy() {
+        use crate::cloth::assembly::{Assembly, AssemblyInputs};
+        use crate::cloth::material::FabricParameters;
+        let fabric = FabricParameters::default();
+        let mut m = ClothModel::grid(0.3, 0.2, 7, 5, fabric).unwrap();
+        m.perturb(Vec3::new(0.3, -0.2, 1.0), 0.02, 7);
+        m.prestrain(-0.03, 0.02);
+        let x = m.mesh.positions.clone();
+        let v = vec![Vec3::zeros(); x.len()];
+        let inp = AssemblyInputs {
+            dt: 0.01,
+            gravity: Vec3::zeros(),
+            matrix: false,
+        };
+        for choi_ko in [false, true] {
+            if choi_ko {
+                m.enable_choi_ko();
+            }
+            let e = energy_parts(&m, &x);
+            let assembled = Assembly::new(&m).assemble(&m, &x, &v, inp);
+            assert!(e.stretch > 0.0 && e.shear > 0.0);
+            assert_eq!(e.bending > 0.0, !choi_ko);
+            assert_eq!(e.flexion > 0.0, choi_ko);
+            assert!(
+                (e.total() - assembled).abs() <= 1e-12 * assembled,
+                "{e:?} against {assembled}"
+            );
+        }
     }
 }

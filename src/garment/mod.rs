@@ -17,6 +17,7 @@ mod mesh_boundary;
 mod mesh_graph;
 pub mod outline;
 mod over_the_top;
+pub mod patch;
 pub mod pattern;
 pub mod preposition;
 mod relax;

@@ -151,6 +151,21 @@ pub fn register(engine: &mut Engine) {
         });
     register!(
         engine,
+        "cloth_patch",
+        ["width: float", "height: float", "edge: float", "fabric: Fabric", "Cloth"],
+        "A `width` × `height` m rectangle meshed with irregular triangles about `edge` m long (the\npattern mesher's constrained Delaunay), flat in the XY plane at z = 0, centred at the\norigin, the warp along x: a triangle-mesh cloth (hinges, no grid lines).",
+        |w: Dynamic, h: Dynamic, e: Dynamic, f: Fabric| -> RResult<ClothHandle> {
+            let mesh = crate::garment::patch::rectangle_mesh(
+                num(&w, "width")?,
+                num(&h, "height")?,
+                num(&e, "edge")?,
+            )
+            .map_err(|e| rt_err(e.to_string()))?;
+            Ok(ClothHandle(Shared::new(ClothModel::from_mesh(mesh, f.0)?)))
+        }
+    );
+    register!(
+        engine,
         "cloth_obj",
         ["path: String", "fabric: Fabric", "Cloth"],
         "A cloth from an OBJ mesh whose texture coordinates are the flat pattern (m).",

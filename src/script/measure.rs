@@ -7,7 +7,7 @@ use rhai::{Array, Dynamic, Engine, Map, INT};
 
 use super::convert::{finite, index, non_negative, rt_err, RResult};
 use super::{register, SimHandle};
-use crate::cloth::wrinkles::{compressed_springs, wrinkles_along};
+use crate::cloth::wrinkles::{compressed_springs, energy_parts, wrinkles_along};
 use crate::geometry::Vec3;
 use crate::render::plot::{write_plot_pair, write_series_csv, PlotSpec, Series, SeriesStyle};
 
@@ -35,6 +35,23 @@ pub fn register(engine: &mut Engine) {
             m.insert("springs".into(), Dynamic::from_int(c.springs as INT));
             m.insert("compressed".into(), Dynamic::from_int(c.compressed as INT));
             m.insert("fraction".into(), Dynamic::from_float(c.fraction()));
+            Ok(m)
+        });
+    register!(engine, "energy_parts", ["sim: Simulation", "Map"],
+        "The elastic energy now, split by what stores it (J): #{stretch, shear, bending, flexion\n(Choi–Ko's buckled connections), total}.",
+        |h: &mut SimHandle| -> RResult<Map> {
+            let sim = h.get()?;
+            let e = energy_parts(&sim.model, &sim.state.x);
+            let mut m = Map::new();
+            for (k, v) in [
+                ("stretch", e.stretch),
+                ("shear", e.shear),
+                ("bending", e.bending),
+                ("flexion", e.flexion),
+                ("total", e.total()),
+            ] {
+                m.insert(k.into(), Dynamic::from_float(v));
+            }
             Ok(m)
         });
     register!(engine, "wrinkles", ["sim: Simulation", "line: Array", "threshold: float", "Map"],

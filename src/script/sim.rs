@@ -266,7 +266,7 @@ pub fn register(engine: &mut Engine) {
         engine,
         "compression_release",
         ["sim: Simulation", "options: Map"],
-        "Turns on the seed report's compression-release buckling model (grid cloths): each step the
+        "Turns on the seed report's compression-release buckling model (grids and triangle meshes): each step the
 most compressed springs' particles are sent to where their springs regain their rest length
 (three spheres' intersection) and held there. `#{strain: 0.01, hold_steps: 3, seed: 1}`: the
 compression that triggers a release, how long a particle is held, the seed of the random
@@ -291,8 +291,7 @@ up/down choice on a flat cloth.",
                 o.seed = v.as_int().map_err(|_| rt_err("`seed` must be an int"))? as u64;
             }
             let mut sim = h.get_mut()?;
-            let cr = CompressionRelease::new(&sim.model, o)
-                .ok_or_else(|| rt_err("compression_release needs a grid cloth"))?;
+            let cr = CompressionRelease::new(&sim.model, o);
             sim.add_hook(Box::new(cr));
             Ok(())
         }
