@@ -272,8 +272,21 @@ impl Camera {
         width: u32,
         height: u32,
     ) -> Camera {
+        Camera::looking_at_up(eye, target, Vector3::y(), focal, width, height)
+    }
+
+    /// [`Camera::looking_at`] with `up` (a world direction, not along the view) up in the
+    /// image: the z-up worlds of the tracking sequences pass +z.
+    pub fn looking_at_up(
+        eye: Vector3<f64>,
+        target: Vector3<f64>,
+        up: Vector3<f64>,
+        focal: f64,
+        width: u32,
+        height: u32,
+    ) -> Camera {
         let f = (target - eye).normalize();
-        let right = f.cross(&Vector3::y()).normalize();
+        let right = f.cross(&up).normalize();
         let down = f.cross(&right);
         let rotation = Matrix3::from_rows(&[right.transpose(), down.transpose(), f.transpose()]);
         Camera::new(

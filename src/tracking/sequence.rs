@@ -47,7 +47,6 @@ use std::time::Instant;
 
 use image::RgbImage;
 use indicatif::ProgressBar;
-use nalgebra::Matrix3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -223,25 +222,11 @@ pub fn ring_cameras(
                 centre.y + radius * az.sin(),
                 h,
             );
-            let f = (centre - eye).normalize();
-            let right = f.cross(&Vec3::z()).normalize();
-            let down = f.cross(&right);
-            let rotation =
-                Matrix3::from_rows(&[right.transpose(), down.transpose(), f.transpose()]);
             let dist = (centre - eye).norm();
             let focal = 0.7 * height as f64 * dist / 1.9;
             let cam = Camera {
                 k1: -0.03,
-                ..Camera::new(
-                    focal,
-                    focal,
-                    (width as f64 - 1.0) / 2.0,
-                    (height as f64 - 1.0) / 2.0,
-                    rotation,
-                    -(rotation * eye),
-                    width,
-                    height,
-                )
+                ..Camera::looking_at_up(eye, centre, Vec3::z(), focal, width, height)
             };
             cam.validate_named(&format!("cam{k}"))?;
             Ok(cam)
