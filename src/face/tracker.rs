@@ -716,6 +716,7 @@ impl FaceTracker {
             levels: (0..layers).map(|l| usize::from(l < layers / 2)).collect(),
             survival: 0.5,
             decay: 0.6,
+            ..Default::default()
         };
         let clamp = |p: &mut [f64]| {
             for (x, (lo, hi)) in p.iter_mut().zip(&ranges) {

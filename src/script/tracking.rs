@@ -48,6 +48,12 @@ fn options(m: &Map) -> RResult<(TrackerOptions, TrackOutputOptions, Option<Strin
             }
             "background_frames" => o.background_frames = count(v, "background_frames")?,
             "prediction" => o.prediction = finite(v, "prediction")?,
+            "prior_weight" => o.prior_weight = finite(v, "prior_weight")?,
+            "limb_restarts" => {
+                o.limb_restarts = v
+                    .as_bool()
+                    .map_err(|_| rt_err("`limb_restarts` must be true or false"))?
+            }
             "seed" => o.seed = count(v, "seed")? as u64,
             "frames" => o.frames = Some(count(v, "frames")?),
             "overlay_every" => out.overlay_every = count(v, "overlay_every")?,
@@ -55,7 +61,8 @@ fn options(m: &Map) -> RResult<(TrackerOptions, TrackOutputOptions, Option<Strin
             other => {
                 return Err(rt_err(format!(
                 "track_body: unknown option `{other}` (particles, layers, passes, robust_sigma, \
-                     mesh_cell, lbs, background_frames, prediction, seed, frames, \
+                     mesh_cell, lbs, background_frames, prediction, prior_weight, limb_restarts, seed, \
+                     frames, \
                      overlay_every, makehuman)"
             )))
             }
@@ -143,8 +150,10 @@ truth), s_per_frame, stage_seconds (per frame), start_seconds, files}.",
         "As `track_body(seq, out)` with options: `particles` per layer, `layers` (pyramid level
 of each annealing layer, coarse first, e.g. [1, 1, 1, 0, 0]), `robust_sigma` (grey levels),
 `mesh_cell` (metres), `lbs` (linear blend skinning instead of rigid), `background_frames`,
-`prediction` (velocity factor), `seed`, `frames` (track only the first frames),
-`passes` (spread factor of each pass of the stage hierarchy per frame, e.g. [1.0, 0.35]),
+`prediction` (velocity factor), `prior_weight` (motion prior per squared move spread,
+default 0.05), `limb_restarts` (limb stages also start from the previous,
+the rest and a half-bent limb pose; default true), `seed`, `frames` (track only the first
+frames), `passes` (spread factor of each pass of the stage hierarchy per frame, e.g. [1.0, 0.35]),
 `overlay_every` (0: no pictures), `makehuman` (folder of the body model).",
         |seq: &str, out: &str, m: Map| track(seq, out, &m)
     );

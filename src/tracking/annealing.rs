@@ -27,6 +27,10 @@ pub struct AnnealSettings {
     pub survival: f64,
     /// Factor applied to the move spread after each layer.
     pub decay: f64,
+    /// Alternative starting points (full parameter vectors; only the searched entries are
+    /// used), each entered once, unperturbed, into the first layer in place of a diffused
+    /// copy of the start; resampling keeps those that explain the data.
+    pub seeds: Vec<Vec<f64>>,
 }
 
 impl Default for AnnealSettings {
@@ -36,6 +40,7 @@ impl Default for AnnealSettings {
             levels: vec![1, 1, 1, 0, 0],
             survival: 0.5,
             decay: 0.6,
+            seeds: Vec::new(),
         }
     }
 }
@@ -108,10 +113,16 @@ where
     let s = scratch;
     s.particles.resize_with(n, Vec::new);
     s.next.resize_with(n, Vec::new);
+    let seeds = settings.seeds.len().min(n - 1);
     for (i, p) in s.particles.iter_mut().enumerate() {
         p.clear();
         p.extend_from_slice(start);
-        if i > 0 {
+        if i > 0 && i <= seeds {
+            for &k in dofs {
+                p[k] = settings.seeds[i - 1][k];
+            }
+            clamp(p);
+        } else if i > 0 {
             for (d, &k) in dofs.iter().enumerate() {
                 p[k] += sigma[d] * rng.normal();
             }
@@ -227,6 +238,46 @@ mod tests {
         let r2 = run(1);
         assert_eq!(r.params, r2.params);
         assert_eq!(r.evaluations, 600);
+    }
+
+    #[test]
+    fn a_seed_in_the_deeper_basin_is_kept_where_small_moves_cannot_reach_it() {
+        // two wells 2 apart: a shallow one at −1 (where the search starts) and a deep one at +1
+        let cost = |p: &[f64], _level: usize| {
+            let a = (p[0] + 1.0).powi(2);
+            let b = (p[0] - 1.0).powi(2) - 0.5;
+            a.min(b)
+        };
+        let run = |seeds: Vec<Vec<f64>>| {
+            let settings = AnnealSettings {
+                particles: 24,
+                levels: vec![0; 6],
+                seeds,
+                ..Default::default()
+            };
+            let mut rng = SplitMix64::new(7);
+            let mut scratch = AnnealScratch::default();
+            anneal(
+                &[-1.0],
+                &[0],
+                &[0.1],
+                &settings,
+                &mut rng,
+                |_| {},
+                cost,
+                &mut scratch,
+            )
+        };
+        let without = run(Vec::new());
+        assert!(
+            (without.params[0] + 1.0).abs() < 0.1,
+            "{:?}",
+            without.params
+        );
+        // a seed near (not at) the deep well: the annealing moves it to the bottom
+        let with = run(vec![vec![0.8], vec![-3.0]]);
+        assert!((with.params[0] - 1.0).abs() < 0.05, "{:?}", with.params);
+        assert!(with.cost < -0.49);
     }
 
     #[test]

@@ -12,7 +12,7 @@
 //! - [`raster`]: the z-buffered vertex-colour rasterizer shared by sequences and tracker;
 //! - [`clothing`], [`sequence`], [`sequence_files`]: synthetic multi-camera sequences with
 //!   ground truth, and reading any sequence folder;
-//! - [`pyramid`], [`texture`], [`cost`], [`annealing`], [`tracker`]: the tracker;
+//! - [`pyramid`], [`texture`], [`cost`], [`annealing`], [`restarts`], [`tracker`]: the tracker;
 //! - [`bvh_export`], [`overlay`], [`swing_metrics`], [`track_outputs`]: its outputs.
 
 pub mod annealing;
@@ -28,6 +28,7 @@ pub mod puppet;
 pub mod puppet_mesh;
 pub mod pyramid;
 pub mod raster;
+pub mod restarts;
 pub mod sequence;
 pub mod sequence_files;
 pub mod swing_metrics;

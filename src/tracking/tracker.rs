@@ -25,6 +25,7 @@ use super::joints::{mpjpe, JOINT_COUNT};
 use super::puppet::{PartGroup, Puppet};
 use super::puppet_mesh::TrackingMesh;
 use super::pyramid::{median_background, Level};
+use super::restarts::limb_restarts;
 use super::sequence_files::{Sequence, SequenceError};
 use super::texture::learn_colours;
 use crate::body::Mannequin;
@@ -70,6 +71,9 @@ pub struct TrackerOptions {
     pub passes: Vec<f64>,
     /// Weight of the motion prior (per squared move spread of a parameter).
     pub prior_weight: f64,
+    /// Limb stages also start particles from the previous frame's limb pose (no
+    /// prediction), the rest pose and a half-bent pose (see [`limb_restarts`](super::restarts::limb_restarts)).
+    pub limb_restarts: bool,
 }
 
 impl Default for TrackerOptions {
@@ -86,6 +90,7 @@ impl Default for TrackerOptions {
             frames: None,
             passes: vec![1.0, 0.35],
             prior_weight: 0.05,
+            limb_restarts: true,
         }
     }
 }
@@ -225,6 +230,12 @@ impl Tracker {
                 "tracker: robust_sigma and mesh_cell must be positive".into(),
             ));
         }
+        if !(options.prior_weight.is_finite() && options.prior_weight >= 0.0) {
+            return Err(TrackError::Invalid(format!(
+                "tracker: prior_weight must be finite and not negative (got {})",
+                options.prior_weight
+            )));
+        }
         if cameras.len() != backgrounds.len() || cameras.is_empty() {
             return Err(TrackError::Invalid(format!(
                 "tracker: {} cameras but {} background images",
@@ -313,6 +324,16 @@ impl Tracker {
                 self.options.particles
             };
             let sigma: Vec<f64> = spread.iter().map(|s| sigma_scale * s).collect();
+            settings.seeds.clear();
+            if self.options.limb_restarts && s >= 2 && !self.history.is_empty() {
+                limb_restarts(
+                    infos,
+                    &params,
+                    &dofs,
+                    &self.history[self.history.len() - 1],
+                    &mut settings.seeds,
+                );
+            }
             let app = Appearance {
                 puppet: &self.puppet,
                 mesh: &self.mesh,
