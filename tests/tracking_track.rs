@@ -5,6 +5,7 @@
 
 use std::path::PathBuf;
 
+use emilion::geometry::Vec3;
 use emilion::script::run_file;
 use emilion::tracking::sequence_files::{read_joints_csv, Sequence};
 
@@ -25,46 +26,65 @@ fn sets(pairs: &[(&str, &str)]) -> Vec<(String, String)> {
         .collect()
 }
 
-#[test]
-fn punch_is_tracked_without_losing_it() {
-    let dir = temp("punch");
+/// Tracked and true joints of each tracked frame.
+type Frames = Vec<(Vec<Vec3>, Vec<Vec3>)>;
+
+/// Makes a sequence of `clip` (a CMU BVH file; `make_frames` frames, the whole clip if
+/// `None`) in `dir` and tracks it with the scripts and the tracking options `track`; returns
+/// the output folder and the tracked joints with their true positions, per frame.
+fn make_and_track(
+    dir: &std::path::Path,
+    clip: &str,
+    make_frames: Option<usize>,
+    track: &[(&str, &str)],
+) -> (PathBuf, Frames) {
     let seq = dir.join("seq");
     let out = dir.join("track");
-    let motion = root().join("../shared/data/motion/cmu_bvh/002_05.bvh");
-    run_file(
-        &root().join("scripts/make_sequence.rhai"),
-        &sets(&[
-            ("motion", motion.to_str().unwrap()),
-            ("out", seq.to_str().unwrap()),
-            ("frames", "8"),
-        ]),
-    )
-    .unwrap_or_else(|e| panic!("make_sequence.rhai: {e}"));
-    run_file(
-        &root().join("scripts/track_body.rhai"),
-        &sets(&[
-            ("seq", seq.to_str().unwrap()),
-            ("out", out.to_str().unwrap()),
-            ("overlay_every", "4"),
-        ]),
-    )
-    .unwrap_or_else(|e| panic!("track_body.rhai: {e}"));
+    let motion = root().join("../shared/data/motion/cmu_bvh").join(clip);
+    let n = make_frames.map(|f| f.to_string());
+    let mut make = vec![
+        ("motion", motion.to_str().unwrap()),
+        ("out", seq.to_str().unwrap()),
+    ];
+    if let Some(n) = &n {
+        make.push(("frames", n.as_str()));
+    }
+    run_file(&root().join("scripts/make_sequence.rhai"), &sets(&make))
+        .unwrap_or_else(|e| panic!("make_sequence.rhai: {e}"));
+    let mut opts = vec![
+        ("seq", seq.to_str().unwrap()),
+        ("out", out.to_str().unwrap()),
+    ];
+    opts.extend_from_slice(track);
+    run_file(&root().join("scripts/track_body.rhai"), &sets(&opts))
+        .unwrap_or_else(|e| panic!("track_body.rhai: {e}"));
     // the tracked joints, read back, against the ground truth
     let s = Sequence::open(&seq).unwrap();
     let truth = s.ground_truth.as_ref().unwrap();
-    let tracked = read_joints_csv(&out.join("tracked_joints.csv")).unwrap();
-    assert_eq!(tracked.len(), 8);
-    let errors: Vec<f64> = tracked
-        .iter()
-        .map(|(k, _, j)| {
-            1000.0
-                * j.iter()
-                    .zip(&truth[*k])
-                    .map(|(a, b)| (a - b).norm())
-                    .sum::<f64>()
-                / 16.0
-        })
+    let frames = read_joints_csv(&out.join("tracked_joints.csv"))
+        .unwrap()
+        .into_iter()
+        .map(|(k, _, j)| (j.to_vec(), truth[k].to_vec()))
         .collect();
+    (out, frames)
+}
+
+/// Mean per-joint position error of each frame (mm).
+fn frame_errors(frames: &Frames) -> Vec<f64> {
+    frames
+        .iter()
+        .map(|(j, t)| {
+            1000.0 * j.iter().zip(t).map(|(a, b)| (a - b).norm()).sum::<f64>() / j.len() as f64
+        })
+        .collect()
+}
+
+#[test]
+fn punch_is_tracked_without_losing_it() {
+    let dir = temp("punch");
+    let (out, frames) = make_and_track(&dir, "002_05.bvh", Some(8), &[("overlay_every", "4")]);
+    assert_eq!(frames.len(), 8);
+    let errors = frame_errors(&frames);
     let mean = errors.iter().sum::<f64>() / errors.len() as f64;
     let worst = errors.iter().cloned().fold(0.0, f64::max);
     assert!(
@@ -92,53 +112,24 @@ fn punch_is_tracked_without_losing_it() {
 #[test]
 fn running_shin_folded_behind_the_occluder_comes_back() {
     let dir = temp("run");
-    let seq = dir.join("seq");
-    let out = dir.join("track");
-    let motion = root().join("../shared/data/motion/cmu_bvh/002_03.bvh");
     // the whole clip is made (its background statistics decide the masks), the first 24
     // frames are tracked
-    let frames = 24;
-    run_file(
-        &root().join("scripts/make_sequence.rhai"),
-        &sets(&[
-            ("motion", motion.to_str().unwrap()),
-            ("out", seq.to_str().unwrap()),
-        ]),
-    )
-    .unwrap_or_else(|e| panic!("make_sequence.rhai: {e}"));
-    run_file(
-        &root().join("scripts/track_body.rhai"),
-        &sets(&[
-            ("seq", seq.to_str().unwrap()),
-            ("out", out.to_str().unwrap()),
-            ("overlay_every", "0"),
-            ("frames", &frames.to_string()),
-        ]),
-    )
-    .unwrap_or_else(|e| panic!("track_body.rhai: {e}"));
-    let s = Sequence::open(&seq).unwrap();
-    let truth = s.ground_truth.as_ref().unwrap();
-    let tracked = read_joints_csv(&out.join("tracked_joints.csv")).unwrap();
-    assert_eq!(tracked.len(), frames);
+    let (_, frames) = make_and_track(
+        &dir,
+        "002_03.bvh",
+        None,
+        &[("overlay_every", "0"), ("frames", "24")],
+    );
+    assert_eq!(frames.len(), 24);
     let l_ankle = emilion::tracking::joints::joint_index("l_ankle").unwrap();
-    let ankle: Vec<f64> = tracked
+    let ankle: Vec<f64> = frames
         .iter()
-        .map(|(k, _, j)| 1000.0 * (j[l_ankle] - truth[*k][l_ankle]).norm())
+        .map(|(j, t)| 1000.0 * (j[l_ankle] - t[l_ankle]).norm())
         .collect();
-    let mean: f64 = tracked
-        .iter()
-        .map(|(k, _, j)| {
-            1000.0
-                * j.iter()
-                    .zip(&truth[*k])
-                    .map(|(a, b)| (a - b).norm())
-                    .sum::<f64>()
-                / 16.0
-        })
-        .sum::<f64>()
-        / frames as f64;
+    let errors = frame_errors(&frames);
+    let mean = errors.iter().sum::<f64>() / errors.len() as f64;
     println!("left ankle errors (mm): {ankle:.0?}; MPJPE {mean:.1} mm");
-    let ankle_mean = ankle.iter().sum::<f64>() / frames as f64;
+    let ankle_mean = ankle.iter().sum::<f64>() / ankle.len() as f64;
     assert!(
         ankle.iter().all(|&e| e <= 150.0) && ankle_mean <= 80.0,
         "left ankle errors (mm): {ankle:.0?}"
