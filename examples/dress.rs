@@ -38,6 +38,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Ok(f) = std::env::var("SEAM_FORCE") {
         params.seam_max_force = f.parse()?;
     }
+    if let Ok(f) = std::env::var("SEAM_HINGES") {
+        params.seam_hinges = f == "1";
+    }
     if let Ok(f) = std::env::var("SELF") {
         params.contact.self_collision = f == "1";
     }
@@ -65,6 +68,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let sim = &mut d.simulation;
     if let (Ok(g), Some(sew)) = (std::env::var("SEW_G"), sim.sewing.as_mut()) {
         sew.sewing_gravity = g.parse()?;
+    }
+    if let (Ok(k), Some(sep)) = (
+        std::env::var("SEP_STEP"),
+        sim.sewing.as_mut().and_then(|s| s.separation.as_mut()),
+    ) {
+        sep.step = k.parse()?;
+    }
+    if let (Ok(k), Some(sew)) = (std::env::var("SETTLE"), sim.sewing.as_mut()) {
+        sew.settle = k.parse()?;
     }
     if let (Ok(k), Some(sew)) = (std::env::var("STITCH"), sim.sewing.as_mut()) {
         sew.stitched.0 = k.parse()?;
@@ -113,7 +125,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                         .fold(0.0, f64::max);
                     print!("{}:{:.1} ", s.name, g * 1e3);
                 }
-                println!();
+                let crossings = sim.contact.self_intersections(&sim.state.x).len();
+                let sewing = sim
+                    .sewing
+                    .as_ref()
+                    .is_some_and(|s| s.sewing_at(sim.state.time));
+                println!("crossings {crossings} sewing {sewing}");
             }
             println!(
                 "t {:.3} s: step {:.1} ms (assemble {:.1}, solve {:.1}, collision {:.1}), cg {}, seam gap {:.2} mm, contacts {}, self {}, min distance {:.4}, penetrating {}",
@@ -196,6 +213,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let entry = by.entry(key).or_insert((0, Vec3::zeros()));
             entry.0 += 1;
             entry.1 = sim.state.x[e[0] as usize];
+            if let Some(sep) = sim.sewing.as_ref().and_then(|s| s.separation.as_ref()) {
+                println!(
+                    "  sides edge {:?} tri {:?}",
+                    e.map(|v| sep.side[v as usize]),
+                    t.map(|v| sep.side[v as usize])
+                );
+            }
             if a != b && entry.0 <= 3 {
                 let f = |v: u32| d.garment.flat[v as usize];
                 let x = |v: u32| sim.state.x[v as usize];
@@ -252,6 +276,51 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             &Camera::look_at(eye, target),
         )?;
         println!("wrote {path}");
+    }
+    if let Ok(at) = std::env::var("CLOSE") {
+        // close-ups of a point (`CLOSE=x,y,z`), garment only, one colour per piece
+        let c: Vec<f64> = at.split(',').map(|v| v.parse()).collect::<Result<_, _>>()?;
+        let target = Vec3::new(c[0], c[1], c[2]);
+        let colours = [
+            [220, 80, 60],
+            [60, 140, 220],
+            [90, 190, 90],
+            [220, 190, 60],
+            [170, 90, 200],
+            [80, 200, 200],
+        ];
+        let mut tris: Vec<Vec<[usize; 3]>> = vec![Vec::new(); d.garment.pieces.len()];
+        for t in &sim.model.mesh.triangles {
+            let k = d
+                .garment
+                .pieces
+                .iter()
+                .position(|p| p.vertices.contains(&t[0]))
+                .unwrap_or(0);
+            tris[k].push(*t);
+        }
+        let meshes: Vec<RenderMesh> = tris
+            .iter()
+            .enumerate()
+            .map(|(k, t)| RenderMesh {
+                positions: &sim.state.x,
+                triangles: t,
+                color: colours[k % colours.len()],
+            })
+            .collect();
+        for (view, eye) in [
+            ("close_front", Vec3::new(0.0, -0.12, -0.05)),
+            ("close_back", Vec3::new(0.0, 0.12, -0.05)),
+            ("close_below", Vec3::new(0.02, 0.0, -0.15)),
+        ] {
+            let path = format!("out/examples/{name}_{view}.png");
+            render_png(
+                Path::new(&path),
+                &meshes,
+                &Camera::look_at(target + eye, target),
+            )?;
+            println!("wrote {path}");
+        }
     }
     Ok(())
 }

@@ -438,7 +438,12 @@ impl Assembly {
                     let mut e = 0.0;
                     for k in 0..els.len() {
                         let el = &els[k];
-                        let Some((theta, grad)) = el.angle_and_gradient(x) else {
+                        let angle = if el.weight > 0.0 {
+                            el.angle_and_gradient(x)
+                        } else {
+                            None
+                        };
+                        let Some((theta, grad)) = angle else {
                             for m in 0..4 {
                                 g[4 * k + m] = Vec3::zeros();
                                 for q in 0..4 {
@@ -449,6 +454,7 @@ impl Assembly {
                         };
                         let kappa = theta.abs() * el.edge / el.area;
                         let (mo, dm, w) = el.law(law, kappa);
+                        let (mo, dm, w) = (mo * el.weight, dm * el.weight, w * el.weight);
                         e += el.area * w;
                         // signed moment per width and its tangent in signed curvature
                         let (mut ms, mut dms) = (mo * theta.signum(), dm);

@@ -417,6 +417,11 @@ pub struct Hinge {
     pub area: f64,
     /// Weight of the warp law (cos² of the angle between the warp and the curvature direction).
     pub warp_weight: f64,
+    /// Share of the bending law the hinge carries: 1 for the fabric's own hinges; a hinge
+    /// across a seam is 0 while the seam is sewn and 1 once it is stitched.
+    pub weight: f64,
+    /// Whether the hinge spans a seam (its wings lie on two pieces).
+    pub seam: bool,
 }
 
 impl Hinge {
@@ -466,6 +471,8 @@ mod tests {
             edge: 1.0,
             area: 1.0,
             warp_weight: 1.0,
+            weight: 1.0,
+            seam: false,
         };
         let x = vec![
             Vec3::new(0.0, 0.0, 0.0),

@@ -27,7 +27,7 @@ pub use error::ClothError;
 pub use material::{Direction, FabricParameters, Friction, LinearMaterial, MaterialLaw};
 pub use measured::{MeasuredLaw, ResponseCurve};
 pub use model::ClothModel;
-pub use sewing::Sewing;
+pub use sewing::{Separation, Sewing};
 pub use simulation::{Integrator, PreconditionerKind, Simulation, SimulationParameters};
 pub use state::ClothState;
 pub use stats::StepStats;

@@ -192,6 +192,8 @@ impl ClothModel {
                 edge: l2.sqrt(),
                 area: a0,
                 warp_weight: dv * dv / l2,
+                weight: 1.0,
+                seam: false,
             });
         }
         let area = mesh.vertex_rest_areas();
@@ -246,7 +248,12 @@ impl ClothModel {
                 },
             });
         }
-        for h in std::mem::take(&mut self.hinges) {
+        // hinges across seams stay: their wings' rest coordinates lie on different pieces
+        let (seams, fabric): (Vec<Hinge>, Vec<Hinge>) = std::mem::take(&mut self.hinges)
+            .into_iter()
+            .partition(|h| h.seam);
+        self.hinges = seams;
+        for h in fabric {
             let [_, _, c, d] = h.nodes;
             let (len, warp_weight) = dist(c, d);
             if len > 0.0 {

@@ -13,6 +13,50 @@ use super::elements::SpringKind;
 use super::model::ClothModel;
 use crate::geometry::Vec3;
 
+/// Pieces that belong on the two sides of a plane (the halves of a crotch seam, laid crossing
+/// each other by pre-positioning): while sewing, the vertices of every intersecting
+/// edge–triangle pair of opposite sides step towards their own side, so the crossing undoes
+/// itself inside the pass-through zone instead of being sewn in.
+#[derive(Debug, Clone)]
+pub struct Separation {
+    /// The plane's unit normal (towards side +1).
+    pub normal: Vec3,
+    /// Per particle: +1, −1, or 0 (free: not on such a piece, or on the seam itself).
+    pub side: Vec<i8>,
+    /// How far a crossing vertex moves per step (m).
+    pub step: f64,
+}
+
+impl Separation {
+    /// Moves the vertices of each crossing in `crossings` (edge, triangle) whose edge and
+    /// triangle lie on opposite sides towards their own side, each vertex once; returns how
+    /// many crossings were acted on.
+    pub fn apply(&self, crossings: &[([u32; 2], [u32; 3])], x: &mut [Vec3]) -> usize {
+        let mut acted = 0;
+        let mut moved = std::collections::BTreeSet::new();
+        let side_of = |vs: &[u32]| {
+            vs.iter()
+                .map(|&v| self.side[v as usize])
+                .find(|&s| s != 0)
+                .unwrap_or(0)
+        };
+        for (e, t) in crossings {
+            let (se, st) = (side_of(e), side_of(t));
+            if se == 0 || st == 0 || se == st {
+                continue;
+            }
+            acted += 1;
+            for &v in e.iter().chain(t.iter()) {
+                let s = self.side[v as usize];
+                if s != 0 && moved.insert(v) {
+                    x[v as usize] += self.normal * (f64::from(s) * self.step);
+                }
+            }
+        }
+        acted
+    }
+}
+
 /// A sewing schedule over a range of seam springs of a model.
 #[derive(Debug, Clone)]
 pub struct Sewing {
@@ -43,6 +87,11 @@ pub struct Sewing {
     /// the stitched seam, stiffer than the threads that drew the edges together so that the
     /// fabric's tension across it opens no visible gap.
     pub stitched: (f64, f64),
+    /// The hinges across seams in `model.hinges` (see `garment::seam_hinges`), off while
+    /// sewing and on once stitched.
+    pub hinges: Range<usize>,
+    /// Pieces kept to the two sides of a plane while sewing (none: `None`).
+    pub separation: Option<Separation>,
     /// Self-collision pass-through zones while sewing, one id per particle (0: none; empty:
     /// no zones): pieces drawn together along a seam may pass through each other near it.
     pub pass_through: Vec<u32>,
@@ -90,7 +139,19 @@ impl Sewing {
             sewn_at: None,
             stitched: (10.0 * stiffness, 10.0 * max_force),
             pass_through: Vec::new(),
+            hinges: 0..0,
+            separation: None,
         }
+    }
+
+    /// Adds `hinges` across the seams to `model`, off until the seams are stitched.
+    pub fn add_hinges(&mut self, model: &mut ClothModel, hinges: Vec<super::elements::Hinge>) {
+        let start = model.hinges.len();
+        model.hinges.extend(hinges.into_iter().map(|mut h| {
+            h.weight = 0.0;
+            h
+        }));
+        self.hinges = start..model.hinges.len();
     }
 
     /// When every thread has reached rest length 0 (s).
@@ -137,6 +198,9 @@ impl Sewing {
                     max_force,
                 };
             }
+            for h in &mut model.hinges[self.hinges.clone()] {
+                h.weight = 1.0;
+            }
         }
         if self.sewing_at(t) {
             self.gravity.map(|g| g * self.sewing_gravity)
@@ -165,5 +229,38 @@ impl Sewing {
             .iter()
             .map(|s| (x[s.a] - x[s.b]).norm())
             .fold(0.0, f64::max)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_crossing_between_opposite_sides_steps_each_vertex_towards_its_own_side_once() {
+        // an edge of a left piece (0, 1) through a triangle of a right piece (2, 3, 4), the
+        // triangle's first vertex on the seam (free); vertex 5 is on the left, crossing nothing
+        let sep = Separation {
+            normal: Vec3::new(1.0, 0.0, 0.0),
+            side: vec![1, 1, 0, -1, -1, 1],
+            step: 0.002,
+        };
+        let mut x = vec![Vec3::zeros(); 6];
+        let crossings = [([0, 1], [2, 3, 4]), ([1, 0], [4, 3, 2])];
+        assert_eq!(sep.apply(&crossings, &mut x), 2);
+        for (v, want) in [
+            (0, 0.002),
+            (1, 0.002),
+            (2, 0.0),
+            (3, -0.002),
+            (4, -0.002),
+            (5, 0.0),
+        ] {
+            assert_eq!(x[v].x, want, "vertex {v}");
+        }
+        // pieces of one side are left alone
+        let same = [([0, 1], [5, 1, 0])];
+        assert_eq!(sep.apply(&same, &mut x), 0);
+        assert_eq!(x[5].x, 0.0);
     }
 }

@@ -369,6 +369,12 @@ impl Simulation {
         }
         if let Some(sew) = &self.sewing {
             sew.slow_down(self.state.time, &mut self.state.v);
+            if let Some(sep) = sew.separation.as_ref() {
+                if sew.sewing_at(self.state.time) {
+                    let crossings = self.contact.self_intersections(&self.state.x);
+                    sep.apply(&crossings, &mut self.state.x);
+                }
+            }
         }
         self.contact_stats(&mut st);
         st.step = self.state.step;

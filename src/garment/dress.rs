@@ -9,10 +9,14 @@ use std::time::Instant;
 use super::mesh::{mesh_pattern, GarmentMesh, MeshParameters};
 use super::mesh_graph::Adjacency;
 use super::preposition::{preposition, PrepositionParameters, PrepositionReport};
+use super::seam_hinges::seam_hinges;
 use super::{BodyFrame, Pattern, PatternError, Silhouettes};
 use crate::body::Mannequin;
-use crate::cloth::{ClothModel, FabricParameters, Sewing, Simulation, SimulationParameters};
+use crate::cloth::{
+    ClothModel, FabricParameters, Separation, Sewing, Simulation, SimulationParameters,
+};
 use crate::contact::{Body, ContactSettings, MeshBody};
+use crate::geometry::Vec3;
 
 /// Settings of [`dress`].
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -35,6 +39,8 @@ pub struct DressParameters {
     pub contact: ContactSettings,
     /// Silhouette cell size (m).
     pub silhouette_cell: f64,
+    /// Bending hinges across the seams once stitched (see [`super::seam_hinges`]).
+    pub seam_hinges: bool,
 }
 
 impl Default for DressParameters {
@@ -52,6 +58,7 @@ impl Default for DressParameters {
                 ..Default::default()
             },
             silhouette_cell: 0.005,
+            seam_hinges: true,
         }
     }
 }
@@ -151,6 +158,9 @@ pub fn dress(
         params.sewing_speed,
         sim_params.gravity,
     );
+    if params.seam_hinges {
+        sewing.add_hinges(&mut model, seam_hinges(&garment));
+    }
     let mut sim = Simulation::new(model, sim_params).map_err(cloth_err)?;
     sim.contact.settings = params.contact;
     sim.contact.bodies.push(Body::mesh(skin));
@@ -159,6 +169,7 @@ pub fn dress(
     // crotch of trousers), they may pass through each other near it while sewn
     let crossings = sim.contact.self_intersections(&x);
     sewing.pass_through = pass_through_zones(pattern, &garment, &crossings, PASS_THROUGH);
+    sewing.separation = separation(&garment, &sewing.pass_through, &x, &frame);
     let report = DressReport {
         vertices: x.len(),
         triangles: garment.mesh.triangles.len(),
@@ -174,6 +185,60 @@ pub fn dress(
         garment,
         simulation: sim,
         report,
+    })
+}
+
+/// How far (m) a vertex of a crossing between the two halves of a centre seam moves towards
+/// its own side per step while sewing.
+const SEPARATION_STEP: f64 = 2e-3;
+
+/// The sides of the symmetry plane that the pieces of each pass-through zone keep to (see
+/// [`Separation`]): each piece's side is where the mean of its vertices lies at `x`; the
+/// seam's own vertices, on the plane, are free. `None` without zones.
+fn separation(
+    garment: &GarmentMesh,
+    zones: &[u32],
+    x: &[Vec3],
+    frame: &BodyFrame,
+) -> Option<Separation> {
+    if zones.is_empty() {
+        return None;
+    }
+    let mut side = vec![0i8; x.len()];
+    for (id, seam) in garment.seams.iter().enumerate() {
+        let Some(&(a, b)) = seam.pairs.first() else {
+            continue;
+        };
+        if zones[a] != id as u32 + 1 {
+            continue;
+        }
+        for v0 in [a, b] {
+            let Some(piece) = garment.pieces.iter().find(|p| p.vertices.contains(&v0)) else {
+                continue;
+            };
+            let mean: f64 = piece
+                .vertices
+                .clone()
+                .map(|v| frame.to_body(&x[v])[0])
+                .sum();
+            let s = if mean >= 0.0 { 1 } else { -1 };
+            for v in piece.vertices.clone() {
+                side[v] = s;
+            }
+        }
+    }
+    for seam in &garment.seams {
+        for &(a, b) in &seam.pairs {
+            if side[a] != 0 && side[b] != 0 && side[a] != side[b] {
+                side[a] = 0;
+                side[b] = 0;
+            }
+        }
+    }
+    Some(Separation {
+        normal: frame.left,
+        side,
+        step: SEPARATION_STEP,
     })
 }
 

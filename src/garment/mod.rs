@@ -22,6 +22,7 @@ pub mod pattern;
 pub mod preposition;
 mod relax;
 mod rows;
+pub mod seam_hinges;
 pub mod shell;
 pub mod silhouette;
 pub mod svg;
