@@ -216,12 +216,13 @@ fn separation(
             let Some(piece) = garment.pieces.iter().find(|p| p.vertices.contains(&v0)) else {
                 continue;
             };
-            let mean: f64 = piece
+            // the sign of the summed lateral coordinates is the mean's
+            let lateral: f64 = piece
                 .vertices
                 .clone()
                 .map(|v| frame.to_body(&x[v])[0])
                 .sum();
-            let s = if mean >= 0.0 { 1 } else { -1 };
+            let s = if lateral >= 0.0 { 1 } else { -1 };
             for v in piece.vertices.clone() {
                 side[v] = s;
             }
