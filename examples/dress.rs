@@ -44,7 +44,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Ok(f) = std::env::var("SELF") {
         params.contact.self_collision = f == "1";
     }
-    let sim_params = SimulationParameters::default();
+    let mut sim_params = SimulationParameters::default();
+    if let Ok(p) = std::env::var("PRECOND") {
+        sim_params.preconditioner = serde_json::from_value(serde_json::Value::String(p))?;
+    }
     let mut d = dress(
         &pattern,
         FabricParameters::default(),
@@ -247,6 +250,26 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "total {:.1} s; self-intersections {n}; worst penetrating {worst_inside}",
         t0.elapsed().as_secs_f64()
     );
+    let steps = sim.stats.len().max(1) as f64;
+    let mean =
+        |f: fn(&emilion::cloth::StepStats) -> f64| sim.stats.iter().map(f).sum::<f64>() / steps;
+    print!(
+        "per step: {:.1} ms (assemble {:.1}, solve {:.1}, collision {:.1}), cg {:.1}",
+        mean(|s| s.step_ms),
+        mean(|s| s.assemble_ms),
+        mean(|s| s.solve_ms),
+        mean(|s| s.collision_ms),
+        mean(|s| f64::from(s.cg_iterations))
+    );
+    match sim.multigrid_timing() {
+        Some((setup, apply, count)) => println!(
+            "; {} multigrid levels: setup {:.2} ms per step, V-cycle {:.3} ms",
+            sim.multigrid_levels(),
+            setup * 1e3 / steps,
+            apply * 1e3 / count.max(1) as f64
+        ),
+        None => println!("; block-Jacobi"),
+    }
     std::fs::create_dir_all("out/examples")?;
     let (bp, bt) = match &sim.contact.bodies[0].shape {
         Shape::Mesh(m) => (m.positions().to_vec(), m.triangles().to_vec()),

@@ -2,6 +2,8 @@
 //! (Baraff & Witkin) and the explicit one, constraints (pins, attachments, contact hook),
 //! per-step statistics.
 
+pub mod aggregation;
+pub mod amg;
 pub mod assembly;
 pub mod bcsr;
 pub mod choi_ko;

@@ -4,6 +4,7 @@
 
 use rayon::prelude::*;
 
+use super::amg::AggregationMultigrid;
 use super::bcsr::Bcsr3;
 use super::constraints::Filter;
 use super::multigrid::Multigrid;
@@ -192,6 +193,8 @@ pub enum Preconditioner<'a> {
     BlockJacobi(&'a [Mat3]),
     /// One multigrid V-cycle.
     Multigrid(&'a mut Multigrid),
+    /// One aggregation multigrid V-cycle.
+    Aggregation(&'a mut AggregationMultigrid),
 }
 
 impl Preconditioner<'_> {
@@ -207,6 +210,7 @@ impl Preconditioner<'_> {
                 });
             }
             Preconditioner::Multigrid(mg) => mg.apply(a, r, s),
+            Preconditioner::Aggregation(mg) => mg.apply(a, r, s),
         }
     }
 }

@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
+use super::amg::AggregationMultigrid;
 use super::assembly::{Assembly, AssemblyInputs};
 use super::constraints::{Attachment, ContactHook, Filter, Obstacles, ParticleFilter, Trajectory};
 use super::model::ClothModel;
@@ -32,13 +33,20 @@ pub enum Integrator {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PreconditionerKind {
-    /// Multigrid on grid cloths of at least 16 × 16 particles, block-Jacobi otherwise.
+    /// Multigrid on grid cloths of at least 16 × 16 particles, aggregation multigrid on other
+    /// cloths of at least `AGGREGATION_MIN` particles, block-Jacobi otherwise.
     Auto,
     /// Inverse diagonal 3×3 blocks.
     BlockJacobi,
     /// Geometric multigrid V-cycle with line smoothing (grid cloths only).
     Multigrid,
+    /// Aggregation (algebraic) multigrid V-cycle with block Gauss–Seidel smoothing (any mesh).
+    Aggregation,
 }
+
+/// Smallest non-grid cloth that [`PreconditionerKind::Auto`] preconditions with aggregation
+/// multigrid.
+pub const AGGREGATION_MIN: usize = 1000;
 
 /// Settings of a simulation, SI units; every field settable on its own.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -136,6 +144,7 @@ pub struct Simulation {
     asm: Assembly,
     pcg: PcgWorkspace,
     mg: Option<Multigrid>,
+    amg: Option<AggregationMultigrid>,
 }
 
 impl Simulation {
@@ -151,10 +160,17 @@ impl Simulation {
             (PreconditionerKind::Auto, Some((nx, ny))) if nx.min(ny) >= 16 => {
                 Some(Multigrid::new(&model, &mut asm.a)?)
             }
-            (PreconditionerKind::Auto, _) => None,
             (PreconditionerKind::Multigrid, _) => Some(Multigrid::new(&model, &mut asm.a)?),
+            _ => None,
         };
-        if mg.is_some() {
+        let amg = match params.preconditioner {
+            PreconditionerKind::Aggregation => Some(AggregationMultigrid::new(&model, &asm.a)),
+            PreconditionerKind::Auto if mg.is_none() && n >= AGGREGATION_MIN => {
+                Some(AggregationMultigrid::new(&model, &asm.a))
+            }
+            _ => None,
+        };
+        if mg.is_some() || amg.is_some() {
             // the multigrid enabled the single-precision mirrors its smoother reads
             asm.jacobi = false;
         }
@@ -179,18 +195,26 @@ impl Simulation {
             asm,
             pcg: PcgWorkspace::new(n),
             mg,
+            amg,
             model,
         })
     }
 
     /// Multigrid time spent so far: (setup s, V-cycles s, V-cycle count); `None` without multigrid.
     pub fn multigrid_timing(&self) -> Option<(f64, f64, u64)> {
-        self.mg.as_ref().map(|m| m.timing)
+        self.mg
+            .as_ref()
+            .map(|m| m.timing)
+            .or(self.amg.as_ref().map(|m| m.timing))
     }
 
     /// Levels of the multigrid hierarchy (1 when block-Jacobi preconditions).
     pub fn multigrid_levels(&self) -> usize {
-        self.mg.as_ref().map_or(1, |m| m.depth())
+        self.mg
+            .as_ref()
+            .map(|m| m.depth())
+            .or(self.amg.as_ref().map(|m| m.depth()))
+            .unwrap_or(1)
     }
 
     /// Number of particles.
@@ -430,12 +454,16 @@ impl Simulation {
         if !self.params.warm_start {
             self.dv.fill(Vec3::zeros());
         }
-        let mut precond = match self.mg.as_mut() {
-            Some(mg) => {
+        let mut precond = match (self.mg.as_mut(), self.amg.as_mut()) {
+            (Some(mg), _) => {
                 mg.setup(&self.asm.a, &self.state.x, &self.state.v, &self.filter, inp);
                 Preconditioner::Multigrid(mg)
             }
-            None => Preconditioner::BlockJacobi(&self.asm.pinv),
+            (None, Some(amg)) => {
+                amg.setup(&self.asm.a, &self.filter);
+                Preconditioner::Aggregation(amg)
+            }
+            (None, None) => Preconditioner::BlockJacobi(&self.asm.pinv),
         };
         let mut res = self.pcg.solve(
             &self.asm.a,
@@ -447,7 +475,8 @@ impl Simulation {
             self.params.cg_tolerance,
             self.params.cg_max_iterations,
         );
-        if !res.converged && res.iterations < self.params.cg_max_iterations && self.mg.is_some() {
+        let multigrid = self.mg.is_some() || self.amg.is_some();
+        if !res.converged && res.iterations < self.params.cg_max_iterations && multigrid {
             // the multigrid preconditioner broke down (lost definiteness on an extreme
             // configuration): finish the solve with block-Jacobi from where it stopped
             self.asm.form_block_jacobi();

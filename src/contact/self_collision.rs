@@ -327,7 +327,9 @@ impl SelfCollision {
         self.d_in.extend_from_slice(&self.d);
 
         // candidates stay valid while no displacement changes by more than `margin`
-        let margin = 0.5 * thickness;
+        // (a quarter of the thickness: half the A-shirt's candidate pairs of half a thickness,
+        // 257 000 against 530 000 a step, with the same single detection pass)
+        let margin = 0.25 * thickness;
         let pad = thickness + margin;
         // 1. repulsion of close, approaching pairs
         self.broad_phase(x0, pad);
