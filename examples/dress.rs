@@ -7,7 +7,8 @@
 //!
 //! Environment knobs for experiments: `RELAX` (relaxation sweeps), `SEAM_FORCE` (N),
 //! `SELF` (`0` turns self-collision off), `SEW_G` (share of gravity while sewing), `STITCH`
-//! (stitched seam stiffness, N/m); diagnostics: `DIAG` (per-seam gaps while running, the
+//! (stitched seam stiffness, N/m), `PRECOND` (`aggregation`, `block_jacobi`: the solve's
+//! preconditioner); diagnostics: `DIAG` (per-seam gaps while running, the
 //! worst pair of each seam at the end, self-intersections by pair of pieces), `EVERY` (a line
 //! per step with the largest displacement).
 
