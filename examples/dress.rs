@@ -8,7 +8,7 @@
 //! Environment knobs for experiments: `RELAX` (relaxation sweeps), `SEAM_FORCE` (N),
 //! `SELF` (`0` turns self-collision off), `SEW_G` (share of gravity while sewing), `STITCH`
 //! (stitched seam stiffness, N/m), `PRECOND` (`aggregation`, `block_jacobi`: the solve's
-//! preconditioner); diagnostics: `DIAG` (per-seam gaps while running, the
+//! preconditioner), `FABRIC` (a fabric file, as the scripts' `kes_fabric`); diagnostics: `DIAG` (per-seam gaps while running, the
 //! worst pair of each seam at the end, self-intersections by pair of pieces), `EVERY` (a line
 //! per step with the largest displacement).
 
@@ -49,13 +49,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Ok(p) = std::env::var("PRECOND") {
         sim_params.preconditioner = serde_json::from_value(serde_json::Value::String(p))?;
     }
-    let mut d = dress(
-        &pattern,
-        FabricParameters::default(),
-        &man,
-        &params,
-        sim_params,
-    )?;
+    let (fabric, law) = match std::env::var("FABRIC") {
+        Ok(path) => {
+            let spec = emilion::kes::fabric::read_fabric(Path::new(&path))?;
+            let (f, law) = emilion::kes::lab::measured_fabric(&spec)?;
+            (f, Some(std::sync::Arc::new(law)))
+        }
+        Err(_) => (FabricParameters::default(), None),
+    };
+    let mut d = dress(&pattern, fabric, &man, &params, sim_params)?;
+    if let Some(law) = law {
+        d.simulation.model.set_law(law);
+    }
     println!("{}", serde_json::to_string(&d.report)?);
     println!("set up in {:.2} s", t0.elapsed().as_secs_f64());
     for s in &d.garment.seams {
@@ -129,7 +134,26 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                         .fold(0.0, f64::max);
                     print!("{}:{:.1} ", s.name, g * 1e3);
                 }
-                let crossings = sim.contact.self_intersections(&sim.state.x).len();
+                let list = sim.contact.self_intersections(&sim.state.x);
+                let crossings = list.len();
+                let mut by: std::collections::BTreeMap<(usize, usize), usize> = Default::default();
+                for (e, t) in &list {
+                    let piece = |v: u32| {
+                        d.garment
+                            .pieces
+                            .iter()
+                            .position(|p| p.vertices.contains(&(v as usize)))
+                            .unwrap_or(0)
+                    };
+                    let (a, b) = (piece(e[0]), piece(t[0]));
+                    *by.entry((a.min(b), a.max(b))).or_default() += 1;
+                }
+                for ((a, b), c) in by {
+                    print!(
+                        "[{}x{} {c}] ",
+                        d.garment.pieces[a].name, d.garment.pieces[b].name
+                    );
+                }
                 let sewing = sim
                     .sewing
                     .as_ref()

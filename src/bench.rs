@@ -44,6 +44,10 @@ pub struct BenchResult {
     pub levels: usize,
     /// Mean V-cycles per substep.
     pub vcycles: f64,
+    /// Mean multigrid setup time per substep (ms: coarse operators, smoother factors).
+    pub setup_ms: f64,
+    /// Mean time of one V-cycle (ms).
+    pub vcycle_ms: f64,
     /// Mean collision detection + response time per substep (ms).
     pub collision_ms: f64,
     /// Collision time as a share of the substep time.
@@ -99,7 +103,10 @@ pub fn bench_scene(
             let imax = s.iter().map(|x| x.cg_iterations).max().unwrap_or(0);
             let am = s.iter().map(|x| x.assemble_ms).sum::<f64>() / k;
             let sm = s.iter().map(|x| x.solve_ms).sum::<f64>() / k;
-            let vc = sim.multigrid_timing().map_or(0.0, |t| t.2 as f64 / k);
+            let (setup, apply, cycles) = sim.multigrid_timing().unwrap_or((0.0, 0.0, 0));
+            let vc = cycles as f64 / k;
+            let setup_ms = setup * 1e3 / k;
+            let vcycle_ms = apply * 1e3 / (cycles.max(1) as f64);
             let cm = s.iter().map(|x| x.collision_ms).sum::<f64>() / k;
             let x = sim.state.x.clone();
             let last = sim.contact.report(&x);
@@ -124,6 +131,8 @@ pub fn bench_scene(
                 sim.params.cg_tolerance,
                 vc,
                 sim.multigrid_levels(),
+                setup_ms,
+                vcycle_ms,
             ));
         }
     }
@@ -156,6 +165,8 @@ pub fn bench_scene(
         threads: rayon::current_num_threads(),
         levels: med.8,
         vcycles: med.7,
+        setup_ms: med.9,
+        vcycle_ms: med.10,
         collision_ms: c.1,
         collision_share: c.1 / med.0,
         penetrating: c.2,
