@@ -3,6 +3,12 @@
 //! pyramid level), searches started from the true pose and from perturbed ones, the start
 //! (pre-positioning) per joint, and with a third argument, tracking from the true first pose.
 //! `cargo run --release --example track_diag -- SEQ_DIR CLIP.bvh [truth]`
+//!
+//! Limb mode (`LIMB_FRAMES=24,30`, `LIMB=lowerarm01.L`): the texture learnt at the true first
+//! pose, then per listed frame the cost at the truth against the truth with that bone's
+//! flexion changed, with the left arm's six angles set to `ARM=f,t,s,f,t,s` (upper arm, forearm),
+//! and where a search from the truth ends; with `LIMB_TRACK=N`, tracking from the true first
+//! pose for N frames, printing the arm's angles against the truth.
 
 use std::path::Path;
 
@@ -38,6 +44,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let gt_params: Vec<Vec<f64>> = (0..seq.frames)
         .map(|k| puppet.params_from_pose(&anim.pose_at(k as f64 / seq.fps)))
         .collect();
+    if let Ok(list) = std::env::var("LIMB_FRAMES") {
+        let frames: Vec<usize> = list.split(',').filter_map(|s| s.parse().ok()).collect();
+        let joint = std::env::var("LIMB").unwrap_or_else(|_| "lowerarm01.L".into());
+        return limb_costs(&seq, &mannequin, &gt_params, &frames, &joint);
+    }
     // representation check
     let gt = seq.ground_truth.as_ref().ok_or("no ground truth")?;
     let mut worst: f64 = 0.0;
@@ -198,4 +209,113 @@ fn backgrounds_for(
             .collect());
     }
     Ok(sequence_backgrounds(seq, seq.frames, 25)?)
+}
+
+/// For each of `frames`: the image cost at the true pose against the true pose with bone
+/// `bone`'s flexion set to 0 (straightened) and to ±0.5 rad from the truth, then where a
+/// search started from the truth ends (joint errors), the texture learnt at the true pose of
+/// frame 0.
+fn limb_costs(
+    seq: &Sequence,
+    mannequin: &Mannequin,
+    gt_params: &[Vec<f64>],
+    frames: &[usize],
+    bone: &str,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let backgrounds = backgrounds_for(seq, &[])?;
+    let mut t = emilion::tracking::tracker::Tracker::new(
+        mannequin,
+        &seq.cameras,
+        &backgrounds,
+        Default::default(),
+    )?;
+    let gt = seq.ground_truth.as_ref().ok_or("no ground truth")?;
+    t.start_at(&seq.frame_images(0)?, &gt_params[0])?;
+    let infos = t.puppet().params().to_vec();
+    let flex = infos
+        .iter()
+        .position(|i| i.name == format!("{bone}.flex"))
+        .ok_or("no such bone")?;
+    let names = emilion::tracking::joints::TRACKING_JOINTS;
+    if let Ok(n) = std::env::var("LIMB_TRACK") {
+        // track from the true first pose, printing the limb's parameters against the truth
+        let n: usize = n.parse()?;
+        let dofs: Vec<usize> = (0..infos.len())
+            .filter(|&i| {
+                infos[i]
+                    .name
+                    .starts_with(bone.split('.').next().unwrap_or(bone))
+                    || infos[i].name.starts_with(&format!(
+                        "upperarm01.{}",
+                        bone.rsplit('.').next().unwrap_or("L")
+                    ))
+            })
+            .collect();
+        let label: Vec<&str> = dofs.iter().map(|&i| infos[i].name.as_str()).collect();
+        println!("{label:?}");
+        for k in 1..n.min(seq.frames) {
+            let (p, _) = t.track(&seq.frame_images(k)?)?;
+            let j = t.joints(&p);
+            let wrist = 1000.0 * (j[6] - gt[k][6]).norm();
+            let tr: Vec<String> = dofs.iter().map(|&i| format!("{:+.2}", p[i])).collect();
+            let gv: Vec<String> = dofs
+                .iter()
+                .map(|&i| format!("{:+.2}", gt_params[k][i]))
+                .collect();
+            println!(
+                "{k}: l_wrist {wrist:.0} mm; tracked {} truth {}",
+                tr.join(" "),
+                gv.join(" ")
+            );
+        }
+        return Ok(());
+    }
+    for &k in frames {
+        t.set_frame(&seq.frame_images(k)?)?;
+        let truth = &gt_params[k];
+        let (_, c0) = t.search(truth, 0.0);
+        let mut line = format!(
+            "frame {k}: {bone}.flex {:.2}, cost at truth {c0:.4};",
+            truth[flex]
+        );
+        for (label, value) in [
+            ("straight", 0.0),
+            ("-0.5", truth[flex] - 0.5),
+            ("+0.5", truth[flex] + 0.5),
+        ] {
+            let mut p = truth.clone();
+            p[flex] = value;
+            let (_, c) = t.search(&p, 0.0);
+            line += &format!(" {label} {:+.4}", c - c0);
+        }
+        if let Ok(arm) = std::env::var("ARM") {
+            // the truth with the left arm's six angles replaced
+            let vals: Vec<f64> = arm.split(',').filter_map(|s| s.parse().ok()).collect();
+            let mut p = truth.clone();
+            let first = infos
+                .iter()
+                .position(|i| i.name == "upperarm01.L.flex")
+                .ok_or("no upper arm")?;
+            for (o, v) in vals.iter().enumerate() {
+                p[first + o] = *v;
+            }
+            let (_, c) = t.search(&p, 0.0);
+            line += &format!(" given arm {:+.4}", c - c0);
+        }
+        let (p, c) = t.search(truth, 0.5);
+        let j = t.joints(&p);
+        line += &format!(
+            "; search from truth: cost {:+.4}, flex {:.2},",
+            c - c0,
+            p[flex]
+        );
+        for (i, n) in names.iter().enumerate() {
+            let e = 1000.0 * (j[i] - gt[k][i]).norm();
+            if e > 40.0 {
+                line += &format!(" {} {e:.0}", n.name);
+            }
+        }
+        println!("{line}");
+    }
+    Ok(())
 }
