@@ -248,6 +248,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     t.map(|v| sep.side[v as usize])
                 );
             }
+            if a == b && entry.0 <= 4 {
+                let zones = sim
+                    .sewing
+                    .as_ref()
+                    .map(|s| s.pass_through.clone())
+                    .unwrap_or_default();
+                let zone = |v: u32| zones.get(v as usize).copied().unwrap_or(0);
+                println!(
+                    "  {} through itself: edge {:?} (zones {:?}) at {:?}, triangle {:?} (zones {:?})",
+                    d.garment.pieces[a].name,
+                    e,
+                    e.map(zone),
+                    sim.state.x[e[0] as usize].as_slice(),
+                    t,
+                    t.map(zone)
+                );
+            }
             if a != b && entry.0 <= 3 {
                 let f = |v: u32| d.garment.flat[v as usize];
                 let x = |v: u32| sim.state.x[v as usize];

@@ -80,6 +80,11 @@ pub struct DressReport {
     pub preposition: PrepositionReport,
     /// When the last seam thread reaches rest length 0 (simulated s).
     pub closing_time: f64,
+    /// Crossings of a piece with itself left after the pre-positioned knots were smoothed
+    /// open (see the pass-through zones).
+    pub knots_left: usize,
+    /// Intersecting edge–triangle pairs at the start of the simulation.
+    pub crossings: usize,
 }
 
 /// A garment in its simulation, ready to be sewn and draped.
@@ -165,8 +170,20 @@ pub fn dress(
     sim.contact.settings = params.contact;
     sim.contact.bodies.push(Body::mesh(skin));
     sim.contact.set_welds(x.len(), &pairs);
-    // where pre-positioning left the two pieces of a centre seam crossing each other (the
-    // crotch of trousers), they may pass through each other near it while sewn
+    let crossings = sim.contact.self_intersections(&sim.state.x);
+    let crossed = crossed_centre_pieces(pattern, &garment, &crossings);
+    keep_to_sides(
+        &garment,
+        &crossed,
+        &frame,
+        params.preposition.clearance,
+        &mut sim.state.x,
+    );
+    let knots_left = untangle_knots(&garment, &mut sim);
+    let x = sim.state.x.clone();
+    // where pre-positioning left two pieces of a centre seam crossing each other, or a piece
+    // through itself (the crotch of trousers), they may pass through each other near there
+    // while sewn
     let crossings = sim.contact.self_intersections(&x);
     sewing.pass_through = pass_through_zones(pattern, &garment, &crossings, PASS_THROUGH);
     sewing.separation = separation(&garment, &sewing.pass_through, &x, &frame);
@@ -178,6 +195,8 @@ pub fn dress(
         body_seconds: (t2 - t1).as_secs_f64(),
         preposition: pre,
         closing_time: sewing.closing_time(),
+        knots_left,
+        crossings: crossings.len(),
     };
     sewing.sewing_gravity = params.sewing_gravity;
     sim.sewing = Some(sewing);
@@ -186,6 +205,129 @@ pub fn dress(
         simulation: sim,
         report,
     })
+}
+
+/// The pieces of the centre seams (seams joining two pieces laid on the same side of the
+/// body: a crotch seam, a centre back) whose two pieces cross each other in `crossings`.
+fn crossed_centre_pieces(
+    pattern: &Pattern,
+    garment: &GarmentMesh,
+    crossings: &[([u32; 2], [u32; 3])],
+) -> Vec<usize> {
+    let side = |k: usize| {
+        pattern
+            .pieces
+            .iter()
+            .find(|p| p.name == garment.pieces[k].name)
+            .and_then(|p| p.placement.as_ref())
+            .map(|pl| pl.side)
+    };
+    let piece_of = |v: usize| garment.pieces.iter().position(|p| p.vertices.contains(&v));
+    let mut out = Vec::new();
+    for seam in &garment.seams {
+        let Some(&(a, b)) = seam.pairs.first() else {
+            continue;
+        };
+        let (Some(pa), Some(pb)) = (piece_of(a), piece_of(b)) else {
+            continue;
+        };
+        if pa == pb || side(pa).is_none() || side(pa) != side(pb) {
+            continue;
+        }
+        let crossed = crossings.iter().any(|(e, t)| {
+            let (p, q) = (piece_of(e[0] as usize), piece_of(t[0] as usize));
+            (p, q) == (Some(pa), Some(pb)) || (p, q) == (Some(pb), Some(pa))
+        });
+        if crossed {
+            out.extend([pa, pb]);
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+/// Moves each of `pieces` (the two halves of a centre seam laid through each other by
+/// pre-positioning, such as a trouser's crotch extension over the other leg) to its own side
+/// of the body's plane of symmetry (the side of the mean of its vertices): a vertex closer to
+/// the plane than `margin` on its own side, or beyond it, gets the lateral coordinate
+/// `s·g(s·lat)`, `g(u) = m/2 + (m/2) exp((u − m)/(m/2))`, which joins the identity smoothly
+/// at `margin` and never reaches the plane. `g` is strictly increasing, so the map is
+/// one-to-one and does not fold a piece through itself; the two halves no longer cross.
+fn keep_to_sides(
+    garment: &GarmentMesh,
+    pieces: &[usize],
+    frame: &BodyFrame,
+    margin: f64,
+    x: &mut [Vec3],
+) {
+    let half = 0.5 * margin;
+    for &k in pieces {
+        let range = garment.pieces[k].vertices.clone();
+        let mean: f64 = range.clone().map(|v| frame.to_body(&x[v])[0]).sum();
+        let s = if mean >= 0.0 { 1.0 } else { -1.0 };
+        for v in range {
+            let [lat, h, d] = frame.to_body(&x[v]);
+            let u = s * lat;
+            if u < margin {
+                let g = half + half * ((u - margin) / half).exp();
+                x[v] = frame.to_world(s * g, h, d);
+            }
+        }
+    }
+}
+
+/// Smoothing rounds of [`untangle_knots`].
+const KNOT_ROUNDS: usize = 12;
+
+/// Opens the small knots pre-positioning can leave where a piece is laid through itself (a
+/// few neighbouring triangles turned through each other at the crotch): the vertices of each
+/// crossing of a piece with itself, and their neighbours, move halfway to the mean of their
+/// neighbours, for up to `KNOT_ROUNDS` rounds or until none is left. Returns the crossings of
+/// pieces with themselves left.
+fn untangle_knots(garment: &GarmentMesh, sim: &mut Simulation) -> usize {
+    let n = sim.state.x.len();
+    let adjacency = Adjacency::new(&garment.mesh.triangles, n);
+    let mut piece = vec![usize::MAX; n];
+    for (k, p) in garment.pieces.iter().enumerate() {
+        for v in p.vertices.clone() {
+            piece[v] = k;
+        }
+    }
+    let mut marked = vec![false; n];
+    let mut left = 0;
+    for round in 0..=KNOT_ROUNDS {
+        let x = &mut sim.state.x;
+        let knots: Vec<([u32; 2], [u32; 3])> = sim
+            .contact
+            .self_intersections(x)
+            .into_iter()
+            .filter(|(e, t)| piece[e[0] as usize] == piece[t[0] as usize])
+            .collect();
+        left = knots.len();
+        if knots.is_empty() || round == KNOT_ROUNDS {
+            break;
+        }
+        marked.fill(false);
+        for (e, t) in &knots {
+            for &v in e.iter().chain(t.iter()) {
+                marked[v as usize] = true;
+                for &u in adjacency.neighbours(v as usize) {
+                    marked[u] = true;
+                }
+            }
+        }
+        let before = x.clone();
+        for v in (0..n).filter(|&v| marked[v]) {
+            let ring = adjacency.neighbours(v);
+            if ring.is_empty() {
+                continue;
+            }
+            let mean = ring.iter().map(|&u| before[u]).sum::<Vec3>() / ring.len() as f64;
+            x[v] = 0.5 * (before[v] + mean);
+        }
+    }
+    left
 }
 
 /// How far (m) a vertex of a crossing between the two halves of a centre seam moves towards
@@ -247,10 +389,16 @@ fn separation(
 /// through each other while sewn.
 const PASS_THROUGH: f64 = 0.06;
 
+/// Reach of a piece's own pass-through zone, as a multiple of `PASS_THROUGH`.
+const SELF_REACH_SCALE: f64 = 2.0;
+
 /// One pass-through zone per centre seam (a seam joining two pieces laid on the same side of
-/// the body: a crotch seam, a centre back) whose two pieces cross each other in `crossings`
-/// (intersecting edge–triangle pairs): the vertices of both pieces within `reach` of it.
-/// Empty when there is none.
+/// the body: a crotch seam, a centre back): the vertices of both pieces within `reach` of it.
+/// Pre-positioning keeps the two pieces on their own sides of the symmetry plane, but where
+/// four pieces meet (the crotch point) they cannot close without passing each other; the
+/// separation puts back any crossing this leaves. Also one zone per piece laid through itself
+/// in `crossings` (intersecting edge–triangle pairs), within `SELF_REACH_SCALE · reach` of
+/// those crossings. Empty when there is none.
 fn pass_through_zones(
     pattern: &Pattern,
     garment: &GarmentMesh,
@@ -279,18 +427,38 @@ fn pass_through_zones(
         if pa == pb || side(pa).is_none() || side(pa) != side(pb) {
             continue;
         }
-        let crossed = crossings.iter().any(|(e, t)| {
-            let (p, q) = (piece_of(e[0] as usize), piece_of(t[0] as usize));
-            (p, q) == (Some(pa), Some(pb)) || (p, q) == (Some(pb), Some(pa))
-        });
-        if !crossed {
-            continue;
-        }
         let sources: Vec<usize> = seam.pairs.iter().flat_map(|&(a, b)| [a, b]).collect();
         let (dist, _) = adjacency.nearest(&sources, &garment.flat, reach);
         for (v, d) in dist.iter().enumerate() {
             if d.is_finite() {
                 zone[v] = id as u32 + 1;
+                any = true;
+            }
+        }
+    }
+    // a piece laid through itself (a fold of a crotch extension) may pass through itself
+    // near where it does, so the fold can open while it is sewn
+    for (k, piece) in garment.pieces.iter().enumerate() {
+        let sources: Vec<usize> = crossings
+            .iter()
+            .filter(|(e, t)| {
+                piece_of(e[0] as usize) == Some(k) && piece_of(t[0] as usize) == Some(k)
+            })
+            .flat_map(|(e, t)| {
+                e.iter()
+                    .chain(t.iter())
+                    .map(|&v| v as usize)
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        if sources.is_empty() {
+            continue;
+        }
+        let (dist, _) = adjacency.nearest(&sources, &garment.flat, SELF_REACH_SCALE * reach);
+        let id = (garment.seams.len() + k + 1) as u32;
+        for v in piece.vertices.clone() {
+            if dist[v].is_finite() && zone[v] == 0 {
+                zone[v] = id;
                 any = true;
             }
         }

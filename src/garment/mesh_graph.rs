@@ -36,6 +36,11 @@ impl Adjacency {
         }
     }
 
+    /// The vertices sharing an edge with `v`.
+    pub(super) fn neighbours(&self, v: usize) -> &[usize] {
+        &self.next[self.start[v]..self.start[v + 1]]
+    }
+
     /// Shortest path lengths (in the 2D embedding `pos`) from `sources` along mesh edges, up
     /// to `limit`, and each reached vertex's nearest source (unreached vertices: distance
     /// infinite, nearest `usize::MAX`).
