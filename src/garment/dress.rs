@@ -207,13 +207,10 @@ pub fn dress(
     })
 }
 
-/// The pieces of the centre seams (seams joining two pieces laid on the same side of the
-/// body: a crotch seam, a centre back) whose two pieces cross each other in `crossings`.
-fn crossed_centre_pieces(
-    pattern: &Pattern,
-    garment: &GarmentMesh,
-    crossings: &[([u32; 2], [u32; 3])],
-) -> Vec<usize> {
+/// The centre seams of a garment: seams joining two different pieces laid on the same side
+/// of the body (a crotch seam, a centre back), as (seam index, piece of its first edge, piece
+/// of its second edge).
+fn centre_seams(pattern: &Pattern, garment: &GarmentMesh) -> Vec<(usize, usize, usize)> {
     let side = |k: usize| {
         pattern
             .pieces
@@ -222,20 +219,39 @@ fn crossed_centre_pieces(
             .and_then(|p| p.placement.as_ref())
             .map(|pl| pl.side)
     };
-    let piece_of = |v: usize| garment.pieces.iter().position(|p| p.vertices.contains(&v));
     let mut out = Vec::new();
-    for seam in &garment.seams {
+    for (id, seam) in garment.seams.iter().enumerate() {
         let Some(&(a, b)) = seam.pairs.first() else {
             continue;
         };
-        let (Some(pa), Some(pb)) = (piece_of(a), piece_of(b)) else {
+        let (Some(pa), Some(pb)) = (piece_of(garment, a), piece_of(garment, b)) else {
             continue;
         };
-        if pa == pb || side(pa).is_none() || side(pa) != side(pb) {
-            continue;
+        if pa != pb && side(pa).is_some() && side(pa) == side(pb) {
+            out.push((id, pa, pb));
         }
+    }
+    out
+}
+
+/// The piece holding vertex `v`.
+fn piece_of(garment: &GarmentMesh, v: usize) -> Option<usize> {
+    garment.pieces.iter().position(|p| p.vertices.contains(&v))
+}
+
+/// The pieces of the centre seams whose two pieces cross each other in `crossings`.
+fn crossed_centre_pieces(
+    pattern: &Pattern,
+    garment: &GarmentMesh,
+    crossings: &[([u32; 2], [u32; 3])],
+) -> Vec<usize> {
+    let mut out = Vec::new();
+    for (_, pa, pb) in centre_seams(pattern, garment) {
         let crossed = crossings.iter().any(|(e, t)| {
-            let (p, q) = (piece_of(e[0] as usize), piece_of(t[0] as usize));
+            let (p, q) = (
+                piece_of(garment, e[0] as usize),
+                piece_of(garment, t[0] as usize),
+            );
             (p, q) == (Some(pa), Some(pb)) || (p, q) == (Some(pb), Some(pa))
         });
         if crossed {
@@ -405,28 +421,12 @@ fn pass_through_zones(
     crossings: &[([u32; 2], [u32; 3])],
     reach: f64,
 ) -> Vec<u32> {
-    let side = |k: usize| {
-        pattern
-            .pieces
-            .iter()
-            .find(|p| p.name == garment.pieces[k].name)
-            .and_then(|p| p.placement.as_ref())
-            .map(|pl| pl.side)
-    };
-    let piece_of = |v: usize| garment.pieces.iter().position(|p| p.vertices.contains(&v));
+    let piece_of = |v: usize| piece_of(garment, v);
     let adjacency = Adjacency::new(&garment.mesh.triangles, garment.flat.len());
     let mut zone = vec![0u32; garment.flat.len()];
     let mut any = false;
-    for (id, seam) in garment.seams.iter().enumerate() {
-        let Some(&(a, b)) = seam.pairs.first() else {
-            continue;
-        };
-        let (Some(pa), Some(pb)) = (piece_of(a), piece_of(b)) else {
-            continue;
-        };
-        if pa == pb || side(pa).is_none() || side(pa) != side(pb) {
-            continue;
-        }
+    for (id, _, _) in centre_seams(pattern, garment) {
+        let seam = &garment.seams[id];
         let sources: Vec<usize> = seam.pairs.iter().flat_map(|&(a, b)| [a, b]).collect();
         let (dist, _) = adjacency.nearest(&sources, &garment.flat, reach);
         for (v, d) in dist.iter().enumerate() {
