@@ -8,7 +8,7 @@
 //! Environment knobs for experiments: `RELAX` (relaxation sweeps), `SEAM_FORCE` (N),
 //! `SELF` (`0` turns self-collision off), `SEW_G` (share of gravity while sewing), `STITCH`
 //! (stitched seam stiffness, N/m), `PRECOND` (`aggregation`, `block_jacobi`: the solve's
-//! preconditioner), `FABRIC` (a fabric file, as the scripts' `kes_fabric`); diagnostics: `DIAG` (per-seam gaps while running, the
+//! preconditioner), `FABRIC` (a fabric file, as the scripts' `kes_fabric`), `DT` (the step, s); diagnostics: `DIAG` (per-seam gaps while running, the
 //! worst pair of each seam at the end, self-intersections by pair of pieces), `EVERY` (a line
 //! per step with the largest displacement).
 
@@ -46,6 +46,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         params.contact.self_collision = f == "1";
     }
     let mut sim_params = SimulationParameters::default();
+    if let Ok(dt) = std::env::var("DT") {
+        sim_params.dt = dt.parse()?;
+    }
     if let Ok(p) = std::env::var("PRECOND") {
         sim_params.preconditioner = serde_json::from_value(serde_json::Value::String(p))?;
     }

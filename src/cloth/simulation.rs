@@ -293,16 +293,21 @@ impl Simulation {
         self.hooks.push(hook);
     }
 
-    /// Energies of the current state: (kinetic, gravitational, elastic).
+    /// Energies of the current state: (kinetic, gravitational, elastic). Reading them leaves
+    /// the simulation as it was: the internal-friction states the evaluation passes through
+    /// are not committed (they were, so a script printing the energy every frame drove a
+    /// fabric with hysteresis along another trajectory than one that did not).
     pub fn energy(&mut self) -> (f64, f64, f64) {
         let inp = AssemblyInputs {
             dt: self.params.dt,
             gravity: Vec3::from(self.params.gravity),
             matrix: false,
         };
+        let commit = std::mem::replace(&mut self.asm.auto_commit, false);
         let elastic = self
             .asm
             .assemble(&self.model, &self.state.x, &self.state.v, inp);
+        self.asm.auto_commit = commit;
         let (k, g) = self.kinetic_gravity();
         (k, g, elastic)
     }
