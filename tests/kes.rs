@@ -284,7 +284,7 @@ fn reading_the_energy_leaves_a_hysteretic_cloth_on_its_trajectory() {
     let law = Arc::new(law);
     let run = |read: bool| {
         let n = 12;
-        let mut model = ClothModel::grid(0.3, 0.3, n, n, fabric.clone()).unwrap();
+        let mut model = ClothModel::grid(0.3, 0.3, n, n, fabric).unwrap();
         model.set_law(law.clone());
         let params = SimulationParameters {
             dt: 1.0 / 120.0,

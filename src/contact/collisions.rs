@@ -429,7 +429,8 @@ impl Collisions {
             // the slip direction, if it still lies mostly along the surface
             let t = self.slip[i] - s.normal * s.normal.dot(&self.slip[i]);
             let len = t.norm();
-            if !(len > 0.5 * self.slip[i].norm()) {
+            let along = len > 0.5 * self.slip[i].norm(); // false for a zero (or NaN) slip
+            if !along {
                 continue;
             }
             let mu = self.friction_with(s.body).kinetic;
