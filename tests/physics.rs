@@ -51,7 +51,7 @@ fn hanging_strip_tension_equals_weight_below() {
     let law = &*m.law;
     let mut checked = 0;
     for s in &m.springs {
-        let SpringKind::Stretch { warp_weight, .. } = s.kind else {
+        let SpringKind::Stretch { warp_weight } = s.kind else {
             continue;
         };
         if warp_weight != 1.0 {

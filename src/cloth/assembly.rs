@@ -279,7 +279,7 @@ impl Assembly {
                     let mut ev = s.eval(law, &x[s.a], &x[s.b]);
                     e += ev.energy;
                     let fr = match s.kind {
-                        SpringKind::Stretch { warp_weight, .. } if warp_weight >= 0.5 => fr_warp,
+                        SpringKind::Stretch { warp_weight } if warp_weight >= 0.5 => fr_warp,
                         SpringKind::Stretch { .. } => fr_weft,
                         SpringKind::Shear => fr_shear,
                         SpringKind::Seam { .. } | SpringKind::Flexion { .. } => None,

@@ -15,10 +15,6 @@ pub enum SpringKind {
     Stretch {
         /// cos² of the angle between the rest edge and the warp.
         warp_weight: f64,
-        /// Choi & Ko's type-1 connection: compressed, it takes the buckling force of an arc
-        /// of its rest length when that is softer than the stretch law (set by
-        /// `ClothModel::enable_choi_ko`).
-        buckles: bool,
     },
     /// Shear, measured through the stretch of a quad diagonal: γ = 2ε.
     Shear,
@@ -116,17 +112,8 @@ impl Spring {
             let (f, df, w) = stretch(warp_weight);
             return self.softer_of(dir, (f, df, w), buckled(warp_weight));
         }
-        if let SpringKind::Stretch {
-            warp_weight,
-            buckles: true,
-        } = self.kind
-        {
-            if eps < 0.0 {
-                return self.softer_of(dir, stretch(warp_weight), buckled(warp_weight));
-            }
-        }
         let (f, df, w) = match self.kind {
-            SpringKind::Stretch { warp_weight, .. } => stretch(warp_weight),
+            SpringKind::Stretch { warp_weight } => stretch(warp_weight),
             SpringKind::Shear => {
                 let (f, df, w) = law.shear(2.0 * eps);
                 (2.0 * f, 4.0 * df, w)

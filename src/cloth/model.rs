@@ -57,14 +57,8 @@ impl ClothModel {
         let mut springs = Vec::new();
         let mut bend_lines = Vec::new();
         let mut shear_quads = Vec::new();
-        let warp = SpringKind::Stretch {
-            warp_weight: 1.0,
-            buckles: false,
-        };
-        let weft = SpringKind::Stretch {
-            warp_weight: 0.0,
-            buckles: false,
-        };
+        let warp = SpringKind::Stretch { warp_weight: 1.0 };
+        let weft = SpringKind::Stretch { warp_weight: 0.0 };
         for i in 0..ny {
             for j in 0..nx {
                 if j + 1 < nx {
@@ -173,7 +167,6 @@ impl ClothModel {
                 area,
                 kind: SpringKind::Stretch {
                     warp_weight: du * du / l2,
-                    buckles: false,
                 },
             });
         }
@@ -226,23 +219,13 @@ impl ClothModel {
     /// particles two apart along each grid line (replacing the bending lines) or, on a
     /// triangle mesh, between the opposite vertices of each pair of triangles sharing an edge
     /// (replacing the hinges). Each connection stands for the fabric its element stood for, so
-    /// a linear law's bending energy at a given curvature is unchanged. The stretch springs
-    /// become Choi & Ko's type-1 connections: compressed, they take the buckling force of an
-    /// arc of their rest length where it is softer than the stretch law, so a cloth pushed
-    /// against friction buckles instead of storing compression. (This once let a pushed border
-    /// crumple in its plane, 5 J on `scripts/buckle_cylinder.rhai`: the friction stage moved
-    /// attached particles off their targets and stopped the sliding ones every step; with
-    /// both fixed it rests at 0.03–0.04 J against 0.07–0.16 J without a model.) A perfectly
-    /// flat grid pushed in its plane has nothing to lift it and shortens in its plane:
-    /// give it an imperfection ([`ClothModel::perturb`]).
+    /// a linear law's bending energy at a given curvature is unchanged. The stretch springs keep
+    /// the measured law in compression: giving them the buckling force too (Choi & Ko's
+    /// type-1 connections) let a pushed border crumple in its plane (strains from −90 % to
+    /// +490 %, 5 J of spring energy on `scripts/buckle_cylinder.rhai`).
     pub fn enable_choi_ko(&mut self) {
         if self.choi_ko {
             return;
-        }
-        for s in &mut self.springs {
-            if let SpringKind::Stretch { buckles, .. } = &mut s.kind {
-                *buckles = true;
-            }
         }
         let rest = &self.mesh.rest;
         let dist = |p: usize, q: usize| {
