@@ -453,7 +453,9 @@ impl Collisions {
     /// whose kinetic friction was in the solve (`add_kinetic_friction`) keeps its solved
     /// velocity unless the friction reversed it, which stops it (held from the next step). A
     /// new contact loses μk times its normal impulse of tangential momentum and is held if
-    /// that stops it.
+    /// that stops it. A contact that pushed ends with the particle moving with the surface
+    /// along the normal: the push-out to the thickness is a position correction, not a
+    /// velocity the particle keeps.
     #[allow(clippy::too_many_arguments)]
     pub fn end_step(
         &mut self,
@@ -518,6 +520,17 @@ impl Collisions {
             self.slip[i] = vt_new;
             v[i] = s.velocity + vn + vt_new;
             x[i] = x_old[i] + v[i] * dt;
+        }
+        // a contact that pushed leaves the particle on the surface moving with it: the normal
+        // velocity that carried it out to the thickness was a position correction (up to
+        // max_push_speed), and kept as velocity it flew the particle off and the cloth's
+        // forces drove it back in on the next step (a two-step cycle)
+        for i in 0..n {
+            let s = self.slots[i];
+            if s.body != NO_BODY && self.last_impulse[i] > 0.0 {
+                let rel = v[i] - s.velocity;
+                v[i] -= s.normal * s.normal.dot(&rel);
+            }
         }
         // push-out (Provot) and body statistics
         if !self.bodies.is_empty() {
