@@ -524,10 +524,12 @@ impl Collisions {
         // a contact that pushed leaves the particle on the surface moving with it: the normal
         // velocity that carried it out to the thickness was a position correction (up to
         // max_push_speed), and kept as velocity it flew the particle off and the cloth's
-        // forces drove it back in on the next step (a two-step cycle)
+        // forces drove it back in on the next step (a two-step cycle). Not while frictionless
+        // (a garment being sewn: the threads drag the pieces round the body, and without the
+        // push-out speed the trousers' crotch point stayed 4.4 mm open at 16 mm edges)
         for i in 0..n {
             let s = self.slots[i];
-            if s.body != NO_BODY && self.last_impulse[i] > 0.0 {
+            if s.body != NO_BODY && self.last_impulse[i] > 0.0 && !self.frictionless {
                 let rel = v[i] - s.velocity;
                 v[i] -= s.normal * s.normal.dot(&rel);
             }
