@@ -314,11 +314,12 @@ fn cloth_pushed_along_a_cylinder_is_released_by_compression_release() {
         assert_eq!(field(x, "inside"), 0.0, "{x}");
     }
     // compression release: at most 1 % of the springs compressed by more than 1 %, less
-    // spring energy at rest than without a model (the mean over the resting frames: contact
-    // and friction keep the last frames moving)
+    // spring energy at the end than without a model (the figure was the mean over the resting
+    // frames while contacts chattered; since contacts come to rest the energies decay
+    // smoothly after the push, and the one at the end is the acceptance's figure)
     assert!(field(rel, "compressed >1%:") / 3280.0 <= 0.01, "{rel}");
     assert!(
-        field(rel, "resting mean") < field(none, "resting mean"),
+        field(rel, "elastic") < field(none, "elastic"),
         "{none}\n{rel}"
     );
     assert!(dir.join("energy.png").exists() && dir.join("release_24.png").exists());

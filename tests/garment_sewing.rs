@@ -119,7 +119,10 @@ fn sew_at(
 
 #[test]
 fn aaron_is_sewn_and_draped_without_penetration_or_self_intersection() {
-    let (garment, x) = sew("aaron", None, 1.5);
+    // 3 s: a settled drape. With kinetic friction in the solve the back neckline slides down
+    // the neck for longer (top − shoulder 3.22 cm at 1.5 s, 2.78 at 2 s, 2.63 at 3 s, 2.51 at
+    // 4 s; the shoulder seams stay at 1.400 m throughout)
+    let (garment, x) = sew("aaron", None, 3.0);
     // hanging from the shoulders: the shoulder seams are the highest part, above 1.3 m, and
     // the hem hangs below the waist (MakeHuman stands 1.67 m, waist near 1.08 m)
     let top = x.iter().fold(f64::MIN, |m, p| m.max(p.z));

@@ -325,6 +325,17 @@ impl Simulation {
 
     fn build_filter(&mut self, t_end: f64, dt: f64) {
         self.filter.clear();
+        // attachments first: the contact stage and the hooks leave fixed particles alone, so
+        // friction never holds back (or moves) a particle that follows its target
+        for at in &self.attachments {
+            let d = at.trajectory.displacement(t_end);
+            for (k, &i) in at.particles.iter().enumerate() {
+                self.filter.kind[i] = ParticleFilter::Fixed {
+                    target: Vec3::from(at.anchors[k]) + d,
+                };
+                self.filter.any = true;
+            }
+        }
         if self.contact.is_active() {
             self.contact.begin_step(
                 &self.state.x,
@@ -347,15 +358,6 @@ impl Simulation {
                 &mut self.filter,
                 obstacles,
             );
-        }
-        for at in &self.attachments {
-            let d = at.trajectory.displacement(t_end);
-            for (k, &i) in at.particles.iter().enumerate() {
-                self.filter.kind[i] = ParticleFilter::Fixed {
-                    target: Vec3::from(at.anchors[k]) + d,
-                };
-                self.filter.any = true;
-            }
         }
     }
 
@@ -452,6 +454,9 @@ impl Simulation {
         let elastic = self
             .asm
             .assemble(&self.model, &self.state.x, &self.state.v, inp);
+        if self.contact.is_active() {
+            self.contact.add_kinetic_friction(&mut self.asm.b);
+        }
         let t1 = Instant::now();
         for i in 0..self.particle_count() {
             self.z[i] = self.filter.z(i, &self.state.x[i], &self.state.v[i], h);

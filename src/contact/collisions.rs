@@ -188,6 +188,10 @@ pub struct Collisions {
     depth: Vec<f64>,
     self_collision: Option<SelfCollision>,
     inv_mass: Vec<f64>,
+    /// Per particle, the direction it slides along a body (zero if not sliding).
+    slip: Vec<Vec3>,
+    /// Per particle, the unit direction of the kinetic friction put into this step's solve.
+    applied: Vec<Vec3>,
     ms: f64,
 }
 
@@ -312,6 +316,9 @@ impl Collisions {
             if let Some(Shape::Mesh(m)) = self.bodies.get(pin.body).map(|b| &b.shape) {
                 let (at, normal) = pin.anchor(m);
                 let target = pin.target(&at, &normal, t + dt);
+                if matches!(filter.kind[pin.particle], ParticleFilter::Fixed { .. }) {
+                    continue; // a simulation attachment takes precedence
+                }
                 filter.kind[pin.particle] = ParticleFilter::Fixed { target };
                 filter.any = true;
             }
@@ -389,10 +396,66 @@ impl Collisions {
         self.ms = t0.elapsed().as_secs_f64() * 1e3;
     }
 
+    /// Friction coefficients of a contact with body `body` (zero while frictionless).
+    fn friction_with(&self, body: u32) -> FrictionCoefficients {
+        if self.frictionless {
+            return FrictionCoefficients {
+                static_: 0.0,
+                kinetic: 0.0,
+            };
+        }
+        self.settings
+            .friction
+            .combine(&self.bodies[body as usize].friction)
+    }
+
+    /// Kinetic friction inside an implicit step's solve: after `begin_step`, adds to the
+    /// right-hand side `b` (momentum) of each sliding contact the impulse −μk jn t̂, jn the
+    /// normal impulse of its last step and t̂ its slip direction (the last step's tangential
+    /// velocity relative to the body, or the way the particle broke loose). Without it the
+    /// friction would be a correction of the solved velocity, judged by momentum, which a
+    /// particle driven by a stiff spring barely has: it would be stopped on every step and
+    /// never slide. Particles held by static friction are fixed in the solve instead.
+    pub fn add_kinetic_friction(&mut self, b: &mut [Vec3]) {
+        let n = b.len();
+        self.applied.clear();
+        self.applied.resize(n, Vec3::zeros());
+        self.slip.resize(n, Vec3::zeros());
+        for i in 0..n {
+            let s = self.slots[i];
+            if s.body == NO_BODY || s.stuck || self.last_impulse[i] <= 0.0 {
+                continue;
+            }
+            // the slip direction, if it still lies mostly along the surface
+            let t = self.slip[i] - s.normal * s.normal.dot(&self.slip[i]);
+            let len = t.norm();
+            let along = len > 0.5 * self.slip[i].norm(); // false for a zero (or NaN) slip
+            if !along {
+                continue;
+            }
+            let mu = self.friction_with(s.body).kinetic;
+            if mu <= 0.0 {
+                continue;
+            }
+            let t = t / len;
+            b[i] -= t * (mu * self.last_impulse[i]);
+            self.applied[i] = t;
+        }
+    }
+
     /// After the solve: friction from the contact impulses `impulse` (momentum, from the
     /// solve's residual), push-out of vertices inside the thickness, cloth–cloth response, and
     /// statistics. `x_old` are the positions at the start of the step, `x`, `v` the solved end
     /// state (corrected in place), `mass` the particle masses, `filter` the step's filter.
+    ///
+    /// A held particle stays held while the tangential impulse that held it in the solve is
+    /// within μs times the normal one; else it slips the way it was pushed. A slipping particle
+    /// whose kinetic friction was in the solve (`add_kinetic_friction`) keeps its solved
+    /// velocity unless the friction reversed it, which stops it (held from the next step). A
+    /// new contact loses μk times its normal impulse of tangential momentum and is held if
+    /// that stops it. A contact that pushed ends with the particle moving with the surface
+    /// along the normal: the push-out to the thickness is a position correction, not a
+    /// velocity the particle keeps.
     #[allow(clippy::too_many_arguments)]
     pub fn end_step(
         &mut self,
@@ -407,38 +470,45 @@ impl Collisions {
         let t0 = Instant::now();
         let n = x.len();
         let h = self.settings.thickness;
-        // friction at body contacts: a held particle stays held while the tangential impulse
-        // that holds it is within μs times the normal one; a sliding particle loses μk times the
-        // normal impulse of tangential momentum and is held from the next step if that stops it
+        self.applied.resize(n, Vec3::zeros());
+        self.slip.resize(n, Vec3::zeros());
         for i in 0..n {
             let s = self.slots[i];
+            let applied = std::mem::replace(&mut self.applied[i], Vec3::zeros());
             if s.body == NO_BODY {
+                self.slip[i] = Vec3::zeros();
                 continue;
             }
             let jn = s.normal.dot(&impulse[i]);
             self.last_impulse[i] = jn;
             if jn <= 0.0 {
                 self.stuck[i] = false;
+                self.slip[i] = Vec3::zeros();
                 continue;
             }
-            let mut mu = self
-                .settings
-                .friction
-                .combine(&self.bodies[s.body as usize].friction);
-            if self.frictionless {
-                mu = FrictionCoefficients {
-                    static_: 0.0,
-                    kinetic: 0.0,
-                };
-            }
+            let mu = self.friction_with(s.body);
             if s.stuck {
-                let jt = (impulse[i] - s.normal * jn).norm();
-                self.stuck[i] = jt <= mu.static_ * jn;
+                let jt = impulse[i] - s.normal * jn;
+                self.stuck[i] = jt.norm() <= mu.static_ * jn;
+                // the reaction opposed the push: the particle slips the other way
+                self.slip[i] = if self.stuck[i] { Vec3::zeros() } else { -jt };
                 continue;
             }
             let rel = v[i] - s.velocity;
             let vn = s.normal * s.normal.dot(&rel);
             let vt = rel - vn;
+            if applied != Vec3::zeros() {
+                // kinetic friction was in the solve: it stops the particle if it reversed it
+                self.stuck[i] = vt.dot(&applied) <= 0.0;
+                if self.stuck[i] {
+                    v[i] = s.velocity + vn;
+                    x[i] = x_old[i] + v[i] * dt;
+                    self.slip[i] = Vec3::zeros();
+                } else {
+                    self.slip[i] = vt;
+                }
+                continue;
+            }
             let speed = vt.norm();
             let dv = jn / mass[i];
             self.stuck[i] = speed <= mu.static_ * dv;
@@ -447,8 +517,22 @@ impl Collisions {
             } else {
                 vt * (1.0 - mu.kinetic * dv / speed).max(0.0)
             };
+            self.slip[i] = vt_new;
             v[i] = s.velocity + vn + vt_new;
             x[i] = x_old[i] + v[i] * dt;
+        }
+        // a contact that pushed leaves the particle on the surface moving with it: the normal
+        // velocity that carried it out to the thickness was a position correction (up to
+        // max_push_speed), and kept as velocity it flew the particle off and the cloth's
+        // forces drove it back in on the next step (a two-step cycle). Not while frictionless
+        // (a garment being sewn: the threads drag the pieces round the body, and without the
+        // push-out speed the trousers' crotch point stayed 4.4 mm open at 16 mm edges)
+        for i in 0..n {
+            let s = self.slots[i];
+            if s.body != NO_BODY && self.last_impulse[i] > 0.0 && !self.frictionless {
+                let rel = v[i] - s.velocity;
+                v[i] -= s.normal * s.normal.dot(&rel);
+            }
         }
         // push-out (Provot) and body statistics
         if !self.bodies.is_empty() {
