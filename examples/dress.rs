@@ -47,7 +47,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let mut sim_params = SimulationParameters::default();
     if let Ok(dt) = std::env::var("DT") {
-        sim_params.dt = dt.parse()?;
+        sim_params.dt = dt
+            .parse()
+            .map_err(|e| format!("DT={dt:?}: not a step in seconds ({e})"))?;
     }
     if let Ok(p) = std::env::var("PRECOND") {
         sim_params.preconditioner = serde_json::from_value(serde_json::Value::String(p))?;

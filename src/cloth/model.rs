@@ -223,7 +223,7 @@ impl ClothModel {
     /// the measured law in compression: giving them the buckling force too (Choi & Ko's
     /// type-1 connections) let a pushed border crumple in its plane (strains from −90 % to
     /// +490 %, 5 J of spring energy on `scripts/buckle_cylinder.rhai`). With the contact
-    /// friction fixed it no longer crumples, but it still stores the push as in-plane
+    /// friction fixed and contacts at rest it no longer crumples, but it stores the push as in-plane
     /// shortening (5–7 % of the springs shorter by 1 %, no visible wrinkles, 0.021–0.030 J at
     /// rest against 0.016–0.025 J without type-1 on seeds 1–8), and a perfectly flat grid
     /// pushed in its plane keeps half its springs compressed.
