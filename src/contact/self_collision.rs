@@ -69,9 +69,46 @@ pub struct SelfCollision {
     parent: Vec<u32>,
     /// Weld classes: vertices sewn together share a representative (empty: none welded).
     rep: Vec<u32>,
+    /// The weld classes' members (CSR by representative: `class_members[class_start[r]..
+    /// class_start[r + 1]]`; empty: none welded) and, per step, each vertex's class inverse
+    /// mass. An impulse on a welded vertex moves its whole class: moving one side of a seam
+    /// alone opened the seam (a panel's vertex repelled from the other panel's triangle at the
+    /// seam pushed that triangle's seam vertex away from its partner).
+    class_start: Vec<u32>,
+    class_members: Vec<u32>,
+    class_inv: Vec<f64>,
+    /// Per step: whether the vertex's weld class is sewn shut (its members within the
+    /// thickness of each other) and so moves as one. A class still being sewn does not: its
+    /// members may lie on either side of the body.
+    joined: Vec<bool>,
     /// Pass-through zones (0: none): a vertex never collides with a triangle or edge whose
     /// vertices all lie in its own zone (empty: no zones).
     zone: Vec<u32>,
+}
+
+/// What an impulse needs of the weld classes: each vertex's class (`rep`, empty: none), the
+/// classes' members and each vertex's class inverse mass.
+struct Welds<'a> {
+    rep: &'a [u32],
+    start: &'a [u32],
+    members: &'a [u32],
+    inv: &'a [f64],
+    joined: &'a [bool],
+}
+
+impl Welds<'_> {
+    /// Adds `step` to the displacement of `i` and of every vertex sewn to it.
+    #[inline]
+    fn add(&self, d: &mut [Vec3], i: usize, step: Vec3) {
+        if self.rep.is_empty() || !self.joined[i] {
+            d[i] += step;
+        } else {
+            let r = self.rep[i] as usize;
+            for &m in &self.members[self.start[r] as usize..self.start[r + 1] as usize] {
+                d[m as usize] += step;
+            }
+        }
+    }
 }
 
 impl SelfCollision {
@@ -110,6 +147,10 @@ impl SelfCollision {
             moved: Vec::new(),
             parent: Vec::new(),
             rep: Vec::new(),
+            class_start: Vec::new(),
+            class_members: Vec::new(),
+            class_inv: Vec::new(),
+            joined: Vec::new(),
             zone: Vec::new(),
         }
     }
@@ -142,6 +183,24 @@ impl SelfCollision {
             rep[i as usize] = root(&mut rep, i);
         }
         self.rep = if pairs.is_empty() { Vec::new() } else { rep };
+        self.class_start.clear();
+        self.class_members.clear();
+        if !self.rep.is_empty() {
+            let mut count = vec![0u32; n + 1];
+            for &r in &self.rep {
+                count[r as usize + 1] += 1;
+            }
+            for i in 0..n {
+                count[i + 1] += count[i];
+            }
+            let mut fill = count.clone();
+            self.class_members.resize(n, 0);
+            for (i, &r) in self.rep.iter().enumerate() {
+                self.class_members[fill[r as usize] as usize] = i as u32;
+                fill[r as usize] += 1;
+            }
+            self.class_start = count;
+        }
     }
 
     /// Which vertices the last [`SelfCollision::respond`] moved.
@@ -263,7 +322,7 @@ impl SelfCollision {
     /// is at least `target`; returns the correction applied (≥ 0), 0 if none was needed.
     fn push_apart(
         d: &mut [Vec3],
-        inv_mass: &[f64],
+        welds: &Welds,
         vs: &[usize; 4],
         w: &[f64; 4],
         n: &Vec3,
@@ -273,7 +332,7 @@ impl SelfCollision {
         if u >= target {
             return 0.0;
         }
-        Self::impulse(d, inv_mass, vs, w, n, target - u);
+        Self::impulse(d, welds, vs, w, n, target - u);
         target - u
     }
 
@@ -283,12 +342,13 @@ impl SelfCollision {
     /// the pair is then left to the impact zones rather than flung apart.
     fn impulse(
         d: &mut [Vec3],
-        inv_mass: &[f64],
+        welds: &Welds,
         vs: &[usize; 4],
         w: &[f64; 4],
         dir: &Vec3,
         change: f64,
     ) {
+        let inv_mass = welds.inv;
         let den: f64 = (0..4).map(|k| w[k] * w[k] * inv_mass[vs[k]]).sum();
         if den <= 0.0 {
             return;
@@ -302,7 +362,7 @@ impl SelfCollision {
             lambda *= limit / biggest;
         }
         for k in 0..4 {
-            d[vs[k]] += dir * (w[k] * inv_mass[vs[k]] * lambda);
+            welds.add(d, vs[k], dir * (w[k] * inv_mass[vs[k]] * lambda));
         }
     }
 
@@ -325,6 +385,32 @@ impl SelfCollision {
         self.d.extend((0..n).map(|i| x1[i] - x0[i]));
         self.d_in.clear();
         self.d_in.extend_from_slice(&self.d);
+        // a weld class moves as one body: its inverse mass is that of the members' total mass
+        // (0 when one of them is held)
+        self.class_inv.clear();
+        self.class_inv.extend_from_slice(inv_mass);
+        self.joined.clear();
+        self.joined.resize(n, false);
+        if !self.rep.is_empty() {
+            for r in 0..n {
+                let ms = &self.class_members
+                    [self.class_start[r] as usize..self.class_start[r + 1] as usize];
+                let first = ms.first().map(|&m| x0[m as usize]);
+                let shut =
+                    |m: &u32| first.is_some_and(|p| (x0[*m as usize] - p).norm() <= thickness);
+                if ms.len() > 1 && ms.iter().all(shut) {
+                    for &m in ms {
+                        self.joined[m as usize] = true;
+                    }
+                    let held = ms.iter().any(|&m| inv_mass[m as usize] <= 0.0);
+                    let total: f64 = ms.iter().map(|&m| 1.0 / inv_mass[m as usize]).sum();
+                    let inv = if held { 0.0 } else { 1.0 / total };
+                    for &m in ms {
+                        self.class_inv[m as usize] = inv;
+                    }
+                }
+            }
+        }
 
         // candidates stay valid while no displacement changes by more than `margin`
         // (a quarter of the thickness: half the A-shirt's candidate pairs of half a thickness,
@@ -358,11 +444,18 @@ impl SelfCollision {
                 })
                 .collect()
         };
+        let welds = Welds {
+            rep: &self.rep,
+            start: &self.class_start,
+            members: &self.class_members,
+            inv: &self.class_inv,
+            joined: &self.joined,
+        };
         for (k, dist, w, nrm) in close.into_iter().flatten() {
             let vs = self.pair_vertices(k);
             rep.proximities += 1;
             let target = PUSH * (thickness - dist);
-            let dn = Self::push_apart(&mut self.d, inv_mass, &vs, &w, &nrm, target);
+            let dn = Self::push_apart(&mut self.d, &welds, &vs, &w, &nrm, target);
             if dn > 0.0 && friction > 0.0 {
                 // Coulomb: the relative tangential displacement shrinks by μ times the normal change
                 let rel: Vec3 = (0..4).map(|k| self.d[vs[k]] * w[k]).sum();
@@ -370,7 +463,7 @@ impl SelfCollision {
                 let len = tang.norm();
                 if len > 1e-15 {
                     let goal = (len - friction * dn).max(0.0);
-                    Self::impulse(&mut self.d, inv_mass, &vs, &w, &(tang / len), goal - len);
+                    Self::impulse(&mut self.d, &welds, &vs, &w, &(tang / len), goal - len);
                 }
             }
         }
@@ -389,20 +482,20 @@ impl SelfCollision {
                 break;
             }
             rep.ccd_hits += hits.len();
+            let welds = Welds {
+                rep: &self.rep,
+                start: &self.class_start,
+                members: &self.class_members,
+                inv: &self.class_inv,
+                joined: &self.joined,
+            };
             for (k, hit) in &hits {
                 let vs = self.pair_vertices(*k);
                 let s0: f64 = (0..4)
                     .map(|m| hit.weights[m] * x0[vs[m]].dot(&hit.normal))
                     .sum();
                 let target = SEPARATION * thickness - s0;
-                Self::push_apart(
-                    &mut self.d,
-                    inv_mass,
-                    &vs,
-                    &hit.weights,
-                    &hit.normal,
-                    target,
-                );
+                Self::push_apart(&mut self.d, &welds, &vs, &hit.weights, &hit.normal, target);
             }
         }
 
@@ -424,6 +517,16 @@ impl SelfCollision {
                     let vs = self.pair_vertices(*k);
                     for m in 1..4 {
                         union(&mut self.parent, vs[0], vs[m]);
+                    }
+                    // a zone moves the vertices sewn to its members with it
+                    if !self.rep.is_empty() {
+                        for v in vs.into_iter().filter(|&v| self.joined[v]) {
+                            let r = self.rep[v] as usize;
+                            let (a, b) = (self.class_start[r], self.class_start[r + 1]);
+                            for c in a..b {
+                                union(&mut self.parent, v, self.class_members[c as usize] as usize);
+                            }
+                        }
                     }
                 }
                 self.rigidify_zones(x0, inv_mass);
