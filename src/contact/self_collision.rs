@@ -67,36 +67,31 @@ pub struct SelfCollision {
     d_bp: Vec<Vec3>,
     moved: Vec<bool>,
     parent: Vec<u32>,
-    /// Weld classes: vertices sewn together share a representative (empty: none welded).
-    rep: Vec<u32>,
-    /// The weld classes' members (CSR by representative: `class_members[class_start[r]..
-    /// class_start[r + 1]]`; empty: none welded) and, per step, each vertex's class inverse
-    /// mass. An impulse on a welded vertex moves its whole class: moving one side of a seam
-    /// alone opened the seam (a panel's vertex repelled from the other panel's triangle at the
-    /// seam pushed that triangle's seam vertex away from its partner).
-    class_start: Vec<u32>,
-    class_members: Vec<u32>,
-    class_inv: Vec<f64>,
-    /// Per step: whether the vertex's weld class is sewn shut (its members within the
-    /// thickness of each other) and so moves as one. A class still being sewn does not: its
-    /// members may lie on either side of the body.
-    joined: Vec<bool>,
+    /// Vertices sewn together.
+    welds: Welds,
     /// Pass-through zones (0: none): a vertex never collides with a triangle or edge whose
     /// vertices all lie in its own zone (empty: no zones).
     zone: Vec<u32>,
 }
 
-/// What an impulse needs of the weld classes: each vertex's class (`rep`, empty: none), the
-/// classes' members and each vertex's class inverse mass.
-struct Welds<'a> {
-    rep: &'a [u32],
-    start: &'a [u32],
-    members: &'a [u32],
-    inv: &'a [f64],
-    joined: &'a [bool],
+/// Vertices sewn together: each vertex's weld class (`rep`, its representative; empty: none
+/// welded), the classes' members (CSR by representative: `members[start[r]..start[r + 1]]`)
+/// and, per step, each vertex's class inverse mass and whether its class is sewn shut (its
+/// members within the thickness of each other) and so moves as one. An impulse on a vertex of
+/// a sewn-shut class moves the whole class: moving one side of a seam alone opened the seam (a
+/// panel's vertex repelled from the other panel's triangle at the seam pushed that triangle's
+/// seam vertex away from its partner). A class still being sewn does not: its members may lie
+/// on either side of the body.
+#[derive(Debug, Clone, Default)]
+struct Welds {
+    rep: Vec<u32>,
+    start: Vec<u32>,
+    members: Vec<u32>,
+    inv: Vec<f64>,
+    joined: Vec<bool>,
 }
 
-impl Welds<'_> {
+impl Welds {
     /// Adds `step` to the displacement of `i` and of every vertex sewn to it.
     #[inline]
     fn add(&self, d: &mut [Vec3], i: usize, step: Vec3) {
@@ -146,11 +141,7 @@ impl SelfCollision {
             d_bp: Vec::new(),
             moved: Vec::new(),
             parent: Vec::new(),
-            rep: Vec::new(),
-            class_start: Vec::new(),
-            class_members: Vec::new(),
-            class_inv: Vec::new(),
-            joined: Vec::new(),
+            welds: Welds::default(),
             zone: Vec::new(),
         }
     }
@@ -182,24 +173,24 @@ impl SelfCollision {
         for i in 0..n as u32 {
             rep[i as usize] = root(&mut rep, i);
         }
-        self.rep = if pairs.is_empty() { Vec::new() } else { rep };
-        self.class_start.clear();
-        self.class_members.clear();
-        if !self.rep.is_empty() {
+        self.welds.rep = if pairs.is_empty() { Vec::new() } else { rep };
+        self.welds.start.clear();
+        self.welds.members.clear();
+        if !self.welds.rep.is_empty() {
             let mut count = vec![0u32; n + 1];
-            for &r in &self.rep {
+            for &r in &self.welds.rep {
                 count[r as usize + 1] += 1;
             }
             for i in 0..n {
                 count[i + 1] += count[i];
             }
             let mut fill = count.clone();
-            self.class_members.resize(n, 0);
-            for (i, &r) in self.rep.iter().enumerate() {
-                self.class_members[fill[r as usize] as usize] = i as u32;
+            self.welds.members.resize(n, 0);
+            for (i, &r) in self.welds.rep.iter().enumerate() {
+                self.welds.members[fill[r as usize] as usize] = i as u32;
                 fill[r as usize] += 1;
             }
-            self.class_start = count;
+            self.welds.start = count;
         }
     }
 
@@ -242,7 +233,7 @@ impl SelfCollision {
         self.edge_hash.build(&self.edge_boxes, self.cell);
         let (tris, edges) = (&self.triangles, &self.edges);
         let (tri_hash, edge_hash, edge_boxes) = (&self.tri_hash, &self.edge_hash, &self.edge_boxes);
-        let rep = &self.rep;
+        let rep = &self.welds.rep;
         let r = |i: u32| if rep.is_empty() { i } else { rep[i as usize] };
         let zone = &self.zone;
         let z = |i: u32| if zone.is_empty() { 0 } else { zone[i as usize] };
@@ -348,7 +339,7 @@ impl SelfCollision {
         dir: &Vec3,
         change: f64,
     ) {
-        let inv_mass = welds.inv;
+        let inv_mass = &welds.inv;
         let den: f64 = (0..4).map(|k| w[k] * w[k] * inv_mass[vs[k]]).sum();
         if den <= 0.0 {
             return;
@@ -387,26 +378,26 @@ impl SelfCollision {
         self.d_in.extend_from_slice(&self.d);
         // a weld class moves as one body: its inverse mass is that of the members' total mass
         // (0 when one of them is held)
-        self.class_inv.clear();
-        self.class_inv.extend_from_slice(inv_mass);
-        self.joined.clear();
-        self.joined.resize(n, false);
-        if !self.rep.is_empty() {
+        self.welds.inv.clear();
+        self.welds.inv.extend_from_slice(inv_mass);
+        self.welds.joined.clear();
+        self.welds.joined.resize(n, false);
+        if !self.welds.rep.is_empty() {
             for r in 0..n {
-                let ms = &self.class_members
-                    [self.class_start[r] as usize..self.class_start[r + 1] as usize];
+                let ms = &self.welds.members
+                    [self.welds.start[r] as usize..self.welds.start[r + 1] as usize];
                 let first = ms.first().map(|&m| x0[m as usize]);
                 let shut =
                     |m: &u32| first.is_some_and(|p| (x0[*m as usize] - p).norm() <= thickness);
                 if ms.len() > 1 && ms.iter().all(shut) {
                     for &m in ms {
-                        self.joined[m as usize] = true;
+                        self.welds.joined[m as usize] = true;
                     }
                     let held = ms.iter().any(|&m| inv_mass[m as usize] <= 0.0);
                     let total: f64 = ms.iter().map(|&m| 1.0 / inv_mass[m as usize]).sum();
                     let inv = if held { 0.0 } else { 1.0 / total };
                     for &m in ms {
-                        self.class_inv[m as usize] = inv;
+                        self.welds.inv[m as usize] = inv;
                     }
                 }
             }
@@ -444,18 +435,11 @@ impl SelfCollision {
                 })
                 .collect()
         };
-        let welds = Welds {
-            rep: &self.rep,
-            start: &self.class_start,
-            members: &self.class_members,
-            inv: &self.class_inv,
-            joined: &self.joined,
-        };
         for (k, dist, w, nrm) in close.into_iter().flatten() {
             let vs = self.pair_vertices(k);
             rep.proximities += 1;
             let target = PUSH * (thickness - dist);
-            let dn = Self::push_apart(&mut self.d, &welds, &vs, &w, &nrm, target);
+            let dn = Self::push_apart(&mut self.d, &self.welds, &vs, &w, &nrm, target);
             if dn > 0.0 && friction > 0.0 {
                 // Coulomb: the relative tangential displacement shrinks by μ times the normal change
                 let rel: Vec3 = (0..4).map(|k| self.d[vs[k]] * w[k]).sum();
@@ -463,7 +447,7 @@ impl SelfCollision {
                 let len = tang.norm();
                 if len > 1e-15 {
                     let goal = (len - friction * dn).max(0.0);
-                    Self::impulse(&mut self.d, &welds, &vs, &w, &(tang / len), goal - len);
+                    Self::impulse(&mut self.d, &self.welds, &vs, &w, &(tang / len), goal - len);
                 }
             }
         }
@@ -482,20 +466,20 @@ impl SelfCollision {
                 break;
             }
             rep.ccd_hits += hits.len();
-            let welds = Welds {
-                rep: &self.rep,
-                start: &self.class_start,
-                members: &self.class_members,
-                inv: &self.class_inv,
-                joined: &self.joined,
-            };
             for (k, hit) in &hits {
                 let vs = self.pair_vertices(*k);
                 let s0: f64 = (0..4)
                     .map(|m| hit.weights[m] * x0[vs[m]].dot(&hit.normal))
                     .sum();
                 let target = SEPARATION * thickness - s0;
-                Self::push_apart(&mut self.d, &welds, &vs, &hit.weights, &hit.normal, target);
+                Self::push_apart(
+                    &mut self.d,
+                    &self.welds,
+                    &vs,
+                    &hit.weights,
+                    &hit.normal,
+                    target,
+                );
             }
         }
 
@@ -519,12 +503,12 @@ impl SelfCollision {
                         union(&mut self.parent, vs[0], vs[m]);
                     }
                     // a zone moves the vertices sewn to its members with it
-                    if !self.rep.is_empty() {
-                        for v in vs.into_iter().filter(|&v| self.joined[v]) {
-                            let r = self.rep[v] as usize;
-                            let (a, b) = (self.class_start[r], self.class_start[r + 1]);
+                    if !self.welds.rep.is_empty() {
+                        for v in vs.into_iter().filter(|&v| self.welds.joined[v]) {
+                            let r = self.welds.rep[v] as usize;
+                            let (a, b) = (self.welds.start[r], self.welds.start[r + 1]);
                             for c in a..b {
-                                union(&mut self.parent, v, self.class_members[c as usize] as usize);
+                                union(&mut self.parent, v, self.welds.members[c as usize] as usize);
                             }
                         }
                     }
@@ -689,7 +673,7 @@ impl SelfCollision {
             .extend(self.triangles.iter().map(|t| tight(t)));
         self.tri_hash.build(&self.tri_boxes, self.cell);
         let (tris, edges, hash) = (&self.triangles, &self.edges, &self.tri_hash);
-        let rep = &self.rep;
+        let rep = &self.welds.rep;
         let r = |i: u32| if rep.is_empty() { i } else { rep[i as usize] };
         let ne = edges.len();
         let chunk = 1024;
