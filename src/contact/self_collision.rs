@@ -376,8 +376,8 @@ impl SelfCollision {
         self.d.extend((0..n).map(|i| x1[i] - x0[i]));
         self.d_in.clear();
         self.d_in.extend_from_slice(&self.d);
-        // a weld class moves as one body: its inverse mass is that of the members' total mass
-        // (0 when one of them is held)
+        // a sewn-shut weld class moves as one body: its inverse mass is that of the members'
+        // total mass (0 when one of them is held)
         self.welds.inv.clear();
         self.welds.inv.extend_from_slice(inv_mass);
         self.welds.joined.clear();
@@ -394,8 +394,11 @@ impl SelfCollision {
                         self.welds.joined[m as usize] = true;
                     }
                     let held = ms.iter().any(|&m| inv_mass[m as usize] <= 0.0);
-                    let total: f64 = ms.iter().map(|&m| 1.0 / inv_mass[m as usize]).sum();
-                    let inv = if held { 0.0 } else { 1.0 / total };
+                    let inv = if held {
+                        0.0
+                    } else {
+                        1.0 / ms.iter().map(|&m| 1.0 / inv_mass[m as usize]).sum::<f64>()
+                    };
                     for &m in ms {
                         self.welds.inv[m as usize] = inv;
                     }
