@@ -28,10 +28,13 @@ pub struct Bcsr3 {
     pub permuted: Option<PermutedMirror>,
 }
 
-/// The single-precision mirror's blocks again, with the rows stored in another order, columns
-/// keeping their original numbers. A smoother that walks lines across the row order (a grid's
-/// weft lines) then streams through this copy instead of touching every row of the matrix for
-/// each of its colours: at 256² that took three times the memory traffic of the warp lines.
+/// The single-precision mirror's blocks again, renumbered: stored row `p` is original row
+/// `order[p]`, and columns carry the new numbers too, so the copy is the matrix `Qᵀ A Q` of
+/// the permutation `Q`. A smoother that walks lines across the row order (a grid's weft lines)
+/// then works on vectors permuted the same way and streams through memory: reading the
+/// original rows and vectors along a weft line touched every row of the matrix for each of its
+/// colours, and a new cache line and page of each vector at every particle (at 256², a stride
+/// of 6 KB).
 #[derive(Debug, Clone, Default)]
 pub struct PermutedMirror {
     /// Original row of each stored row.
@@ -40,7 +43,8 @@ pub struct PermutedMirror {
     pub start: Vec<usize>,
     /// Where each original row starts in `values`.
     pub row_start: Vec<usize>,
-    /// Block column (original numbering) of each stored block.
+    /// Block column (new numbering) of each stored block, in the original row's order (not
+    /// sorted).
     pub cols: Vec<u32>,
     /// Index of the diagonal block of each stored row.
     pub diag: Vec<usize>,
@@ -65,7 +69,7 @@ impl PermutedMirror {
 pub struct Rows32<'a> {
     /// Start of each stored row in `cols`/`values`.
     pub start: &'a [usize],
-    /// Block column of each block (original numbering).
+    /// Block column of each block (in the stored rows' numbering).
     pub cols: &'a [u32],
     /// Index of the diagonal block of each stored row.
     pub diag: &'a [usize],
@@ -74,12 +78,13 @@ pub struct Rows32<'a> {
 }
 
 impl Rows32<'_> {
-    /// Index of block (stored row `p`, column `j`), if it is in the pattern.
+    /// Index of block (stored row `p`, column `j`), if it is in the pattern (a linear search:
+    /// the permuted copy's columns are not sorted).
     pub fn slot(&self, p: usize, j: usize) -> Option<usize> {
         let (s, e) = (self.start[p], self.start[p + 1]);
         self.cols[s..e]
-            .binary_search(&(j as u32))
-            .ok()
+            .iter()
+            .position(|&c| c == j as u32)
             .map(|k| s + k)
     }
 
@@ -222,6 +227,10 @@ impl Bcsr3 {
         }
         assert_eq!(order.len(), self.rows(), "a permutation of the rows");
         let n = self.rows();
+        let mut inverse = vec![0u32; n];
+        for (p, &i) in order.iter().enumerate() {
+            inverse[i as usize] = p as u32;
+        }
         let mut pm = PermutedMirror {
             order: order.to_vec(),
             start: Vec::with_capacity(n + 1),
@@ -236,8 +245,11 @@ impl Bcsr3 {
             let at = pm.cols.len();
             pm.row_start[i] = at;
             pm.diag.push(at + self.diag[i] - self.row_ptr[i]);
-            pm.cols
-                .extend_from_slice(&self.cols[self.row_ptr[i]..self.row_ptr[i + 1]]);
+            pm.cols.extend(
+                self.cols[self.row_ptr[i]..self.row_ptr[i + 1]]
+                    .iter()
+                    .map(|&j| inverse[j as usize]),
+            );
             pm.start.push(pm.cols.len());
         }
         self.permuted = Some(pm);
@@ -329,20 +341,22 @@ mod tests {
             }
         }
         let x: Vec<Vec3> = (0..n).map(|i| Vec3::new(i as f64, 1.0, 0.5)).collect();
+        // the same vector in the new numbering
+        let xp: Vec<Vec3> = order.iter().map(|&i| x[i as usize]).collect();
         let pm = a.permuted.as_ref().expect("enabled");
         let rows = pm.rows();
         for (p, &i) in order.iter().enumerate() {
             let i = i as usize;
-            // SAFETY: x holds n vectors and nobody writes it.
+            // SAFETY: x and xp hold n vectors and nobody writes them.
             let (yp, yi) = unsafe {
                 (
-                    rows.row_times_ptr(p, x.as_ptr()),
+                    rows.row_times_ptr(p, xp.as_ptr()),
                     a.row_times32_ptr(i, x.as_ptr()),
                 )
             };
             assert_eq!(yp, yi);
-            assert_eq!(pm.cols[pm.diag[p]] as usize, i);
-            assert_eq!(rows.slot(p, i), Some(pm.diag[p]));
+            assert_eq!(pm.cols[pm.diag[p]] as usize, p);
+            assert_eq!(rows.slot(p, p), Some(pm.diag[p]));
         }
     }
 }

@@ -4,8 +4,11 @@
 //! Each line's block-pentadiagonal system (3×3 blocks, neighbours one and two apart) is
 //! factorised exactly once per step; lines are swept in three colours (lines three apart never
 //! share an element), so lines of one colour are solved in parallel, one task per line. Weft
-//! lines read the matrix's permuted mirror, whose rows lie line by line, and their factors are
-//! stored the same way, so both directions stream through memory. No allocation per step.
+//! lines work in the weft numbering (particles column by column): they read the matrix's
+//! permuted mirror and copies of the residual, correction, fixed flags and penalties permuted
+//! the same way (blocked transposes in and out of each sweep), so in either direction a line
+//! is a run of consecutive particles and every array streams through memory. No allocation
+//! per step.
 
 use super::bcsr::{Bcsr3, Mat3f, Rows32, Sym3f};
 use super::parallel::{for_each_index, SyncPtr, PAR_MIN};
@@ -21,11 +24,11 @@ pub enum LineDir {
 }
 
 /// Banded block LU factors of every line of one direction, stored line by line: position
-/// `p = line · len + t` is the line's `t`-th particle.
+/// `p = line · len + t` is the line's `t`-th particle (in that direction's numbering).
 #[derive(Debug, Clone)]
 struct Factors {
-    /// Slots, in this direction's rows, of blocks (k, previous) and (k, previous of previous)
-    /// on the line, or `NONE`.
+    /// Slots, in this direction's rows, of blocks (p, p − 1) and (p, p − 2) on the line, or
+    /// `NONE`.
     prev1: Vec<usize>,
     prev2: Vec<usize>,
     /// Inverse pivots (single precision: a preconditioner, bounded by memory traffic).
@@ -44,6 +47,11 @@ pub struct LineSolver {
     weft: Factors,
     /// Forward-elimination scratch, stored line by line like the factors.
     y: Vec<Vec3>,
+    /// Weft-numbered copies: residual, correction, fixed flags, penalty blocks.
+    r_weft: Vec<Vec3>,
+    e_weft: Vec<Vec3>,
+    fixed_weft: Vec<bool>,
+    pen_weft: Vec<Sym3f>,
 }
 
 const NONE: usize = usize::MAX;
@@ -71,14 +79,13 @@ impl LineSolver {
             };
             let (mut prev1, mut prev2) = (vec![NONE; n], vec![NONE; n]);
             for line in 0..nl {
-                let (first, s, _) = Self::line(nx, ny, dir, line);
                 for t in 0..len {
-                    let (k, p) = (first + t * s, line * len + t);
+                    let p = line * len + t;
                     if t >= 1 {
-                        prev1[p] = rows.slot(p, k - s).unwrap_or(NONE);
+                        prev1[p] = rows.slot(p, p - 1).unwrap_or(NONE);
                     }
                     if t >= 2 {
-                        prev2[p] = rows.slot(p, k - 2 * s).unwrap_or(NONE);
+                        prev2[p] = rows.slot(p, p - 2).unwrap_or(NONE);
                     }
                 }
             }
@@ -99,11 +106,15 @@ impl LineSolver {
             warp,
             weft,
             y: vec![Vec3::zeros(); n],
+            r_weft: vec![Vec3::zeros(); n],
+            e_weft: vec![Vec3::zeros(); n],
+            fixed_weft: vec![false; n],
+            pen_weft: vec![Sym3f::default(); n],
         }
     }
 
-    /// The rows that lines of `dir` read: stored row `line · len + t` is the line's `t`-th
-    /// particle.
+    /// The rows that lines of `dir` read, in that direction's numbering: stored row
+    /// `line · len + t` is the line's `t`-th particle.
     fn rows(a: &Bcsr3, dir: LineDir) -> Rows32<'_> {
         match dir {
             LineDir::Warp => a.rows32(),
@@ -115,19 +126,11 @@ impl LineSolver {
         }
     }
 
-    /// First particle, stride and length of a line.
-    #[inline]
-    fn line(nx: usize, ny: usize, dir: LineDir, line: usize) -> (usize, usize, usize) {
+    /// Number of lines and their length.
+    fn lines(&self, dir: LineDir) -> (usize, usize) {
         match dir {
-            LineDir::Warp => (line * nx, 1, nx),
-            LineDir::Weft => (line, nx, ny),
-        }
-    }
-
-    fn line_count(&self, dir: LineDir) -> usize {
-        match dir {
-            LineDir::Warp => self.ny,
-            LineDir::Weft => self.nx,
+            LineDir::Warp => (self.ny, self.nx),
+            LineDir::Weft => (self.nx, self.ny),
         }
     }
 
@@ -135,11 +138,19 @@ impl LineSolver {
     /// `fixed` particles get identity rows (no correction).
     pub fn factor(&mut self, a: &Bcsr3, fixed: &[bool], pen: Option<&[Sym3f]>) {
         let (nx, ny) = (self.nx, self.ny);
+        transpose(fixed, &mut self.fixed_weft, nx, ny);
+        if let Some(pn) = pen {
+            transpose(pn, &mut self.pen_weft, nx, ny);
+        }
         for dir in [LineDir::Warp, LineDir::Weft] {
-            let nl = self.line_count(dir);
-            let f = match dir {
-                LineDir::Warp => &mut self.warp,
-                LineDir::Weft => &mut self.weft,
+            let (nl, len) = self.lines(dir);
+            let (f, fixed, pen) = match dir {
+                LineDir::Warp => (&mut self.warp, fixed, pen),
+                LineDir::Weft => (
+                    &mut self.weft,
+                    &self.fixed_weft[..],
+                    pen.map(|_| &self.pen_weft[..]),
+                ),
             };
             let rows = Self::rows(a, dir);
             let (gp, u1p, u2p) = (
@@ -148,42 +159,41 @@ impl LineSolver {
                 SyncPtr(f.u2.as_mut_ptr()),
             );
             let (prev1, prev2) = (&f.prev1, &f.prev2);
-            // block (k, k − back) of the line system, zero when either particle is fixed
-            let blk = |k: usize, back: usize, slot: usize| {
-                if slot == NONE || fixed[k] || fixed[k - back] {
+            // block (p, p − back) of the line system, zero when either particle is fixed
+            let blk = |p: usize, back: usize, slot: usize| {
+                if slot == NONE || fixed[p] || fixed[p - back] {
                     Mat3::zeros()
                 } else {
                     rows.values[slot].to_mat3()
                 }
             };
             for_each_index(nl, nx * ny >= PAR_MIN, |line| {
-                let (first, s, len) = Self::line(nx, ny, dir, line);
                 let p0 = line * len;
                 // factors of the two previous particles, kept in double precision
                 let z = Mat3::zeros();
                 let (mut g_1, mut u1_1, mut u2_1) = (z, z, z);
                 let (mut g_2, mut u1_2, mut u2_2) = (z, z, z);
                 for t in 0..len {
-                    let (k, p) = (first + t * s, p0 + t);
+                    let p = p0 + t;
                     let a2 = if t >= 2 {
-                        blk(k, 2 * s, prev2[p])
+                        blk(p, 2, prev2[p])
                     } else {
                         Mat3::zeros()
                     };
                     let mut a1 = if t >= 1 {
-                        blk(k, s, prev1[p])
+                        blk(p, 1, prev1[p])
                     } else {
                         Mat3::zeros()
                     };
-                    let mut d = if fixed[k] {
+                    let mut d = if fixed[p] {
                         Mat3::identity()
                     } else {
                         match pen {
-                            Some(pn) => rows.values[rows.diag[p]].to_mat3() + pn[k].to_mat3(),
+                            Some(pn) => rows.values[rows.diag[p]].to_mat3() + pn[p].to_mat3(),
                             None => rows.values[rows.diag[p]].to_mat3(),
                         }
                     };
-                    // eliminate column k − 2s, then column k − s
+                    // eliminate column p − 2, then column p − 1
                     let l2 = if t >= 2 { a2 * g_2 } else { Mat3::zeros() };
                     if t >= 2 {
                         a1 -= l2 * u1_2;
@@ -194,15 +204,15 @@ impl LineSolver {
                         d -= l1 * u1_1;
                     }
                     let g = d.try_inverse().unwrap_or_else(Mat3::identity);
-                    // upper blocks (k, k + s), (k, k + 2s): transposes of later rows' lower blocks
-                    // (A is symmetric), minus the fill from column k − s
+                    // upper blocks (p, p + 1), (p, p + 2): transposes of later rows' lower blocks
+                    // (A is symmetric), minus the fill from column p − 1
                     let mut u1 = if t + 1 < len {
-                        blk(k + s, s, prev1[p + 1]).transpose()
+                        blk(p + 1, 1, prev1[p + 1]).transpose()
                     } else {
                         Mat3::zeros()
                     };
                     let u2 = if t + 2 < len {
-                        blk(k + 2 * s, 2 * s, prev2[p + 2]).transpose()
+                        blk(p + 2, 2, prev2[p + 2]).transpose()
                     } else {
                         Mat3::zeros()
                     };
@@ -226,7 +236,8 @@ impl LineSolver {
     /// One block Gauss–Seidel sweep over all lines of `dir`: for each of three colours in
     /// `order`, the residual `r − (A + pen) e` of that colour's lines is solved exactly on each
     /// line and added to `e`. Fixed particles keep a zero correction. `from_zero` says `e` is
-    /// zero on entry, which spares the first colour's matrix product.
+    /// zero on entry, which spares the first colour's matrix product. `pen` must be the
+    /// penalty last given to [`LineSolver::factor`].
     #[allow(clippy::too_many_arguments)]
     pub fn sweep(
         &mut self,
@@ -240,61 +251,132 @@ impl LineSolver {
         from_zero: bool,
     ) {
         let (nx, ny) = (self.nx, self.ny);
-        let nl = self.line_count(dir);
-        let f = match dir {
-            LineDir::Warp => &self.warp,
-            LineDir::Weft => &self.weft,
-        };
+        let (nl, len) = self.lines(dir);
         let rows = Self::rows(a, dir);
-        let yp = SyncPtr(self.y.as_mut_ptr());
-        let ep = SyncPtr(e.as_mut_ptr());
-        for (pass, color) in order.into_iter().enumerate() {
-            // with e = 0 on entry, the first colour's residual is r itself
-            let skip_product = from_zero && pass == 0;
-            let count = (nl + 2 - color) / 3;
-            for_each_index(count, nx * ny >= PAR_MIN, |m| {
-                let line = color + 3 * m;
-                let (first, s, len) = Self::line(nx, ny, dir, line);
-                let p0 = line * len;
-                // SAFETY: lines of one colour are three apart, so no element couples two of
-                // them: each task writes its own line's e and y and reads e of other colours only.
-                unsafe {
-                    // residuals of the line, then forward elimination in place
-                    for t in 0..len {
-                        let (k, p) = (first + t * s, p0 + t);
-                        let mut d = if fixed[k] {
-                            Vec3::zeros()
-                        } else if skip_product {
-                            r[k]
-                        } else {
-                            let mut d = r[k] - rows.row_times_ptr(p, ep.0);
-                            if let Some(pn) = pen {
-                                d -= pn[k].mul(&*ep.at(k));
-                            }
-                            d
-                        };
-                        // symmetric elimination: L(k, k−s) = U(k−s, k)ᵀ G(k−s); the scratch
-                        // holds w = G y, so the multiplier is never stored
-                        if t >= 1 {
-                            d -= f.u1[p - 1].cast::<f64>().tr_mul(&*yp.at(p - 1));
-                        }
-                        if t >= 2 {
-                            d -= f.u2[p - 2].cast::<f64>().tr_mul(&*yp.at(p - 2));
-                        }
-                        *yp.at(p) = f.g[p].mul(&d);
-                    }
-                    let (mut x1, mut x2) = (Vec3::zeros(), Vec3::zeros());
-                    for t in (0..len).rev() {
-                        let (k, p) = (first + t * s, p0 + t);
-                        let xk = *yp.at(p)
-                            - f.g[p]
-                                .mul(&(f.u1[p].cast::<f64>() * x1 + f.u2[p].cast::<f64>() * x2));
-                        *ep.at(k) += xk;
-                        x2 = x1;
-                        x1 = xk;
-                    }
+        match dir {
+            LineDir::Warp => {
+                let f = &self.warp;
+                sweep_lines(
+                    f,
+                    rows,
+                    nl,
+                    len,
+                    &mut self.y,
+                    r,
+                    e,
+                    fixed,
+                    pen,
+                    order,
+                    from_zero,
+                );
+            }
+            LineDir::Weft => {
+                transpose(r, &mut self.r_weft, nx, ny);
+                if !from_zero {
+                    transpose(e, &mut self.e_weft, nx, ny);
+                } else {
+                    self.e_weft.fill(Vec3::zeros());
                 }
-            });
+                sweep_lines(
+                    &self.weft,
+                    rows,
+                    nl,
+                    len,
+                    &mut self.y,
+                    &self.r_weft,
+                    &mut self.e_weft,
+                    &self.fixed_weft,
+                    pen.map(|_| &self.pen_weft[..]),
+                    order,
+                    from_zero,
+                );
+                transpose(&self.e_weft, e, ny, nx);
+            }
         }
     }
+}
+
+/// The sweep of [`LineSolver::sweep`] in one direction's numbering: `nl` lines of `len`
+/// consecutive particles.
+#[allow(clippy::too_many_arguments)]
+fn sweep_lines(
+    f: &Factors,
+    rows: Rows32<'_>,
+    nl: usize,
+    len: usize,
+    y: &mut [Vec3],
+    r: &[Vec3],
+    e: &mut [Vec3],
+    fixed: &[bool],
+    pen: Option<&[Sym3f]>,
+    order: [usize; 3],
+    from_zero: bool,
+) {
+    let yp = SyncPtr(y.as_mut_ptr());
+    let ep = SyncPtr(e.as_mut_ptr());
+    for (pass, color) in order.into_iter().enumerate() {
+        // with e = 0 on entry, the first colour's residual is r itself
+        let skip_product = from_zero && pass == 0;
+        let count = (nl + 2 - color) / 3;
+        for_each_index(count, nl * len >= PAR_MIN, |m| {
+            let p0 = (color + 3 * m) * len;
+            // SAFETY: lines of one colour are three apart, so no element couples two of
+            // them: each task writes its own line's e and y and reads e of other colours only.
+            unsafe {
+                // residuals of the line, then forward elimination in place
+                for p in p0..p0 + len {
+                    let mut d = if fixed[p] {
+                        Vec3::zeros()
+                    } else if skip_product {
+                        r[p]
+                    } else {
+                        let mut d = r[p] - rows.row_times_ptr(p, ep.0);
+                        if let Some(pn) = pen {
+                            d -= pn[p].mul(&*ep.at(p));
+                        }
+                        d
+                    };
+                    // symmetric elimination: L(p, p−1) = U(p−1, p)ᵀ G(p−1); the scratch
+                    // holds w = G y, so the multiplier is never stored
+                    if p >= p0 + 1 {
+                        d -= f.u1[p - 1].cast::<f64>().tr_mul(&*yp.at(p - 1));
+                    }
+                    if p >= p0 + 2 {
+                        d -= f.u2[p - 2].cast::<f64>().tr_mul(&*yp.at(p - 2));
+                    }
+                    *yp.at(p) = f.g[p].mul(&d);
+                }
+                let (mut x1, mut x2) = (Vec3::zeros(), Vec3::zeros());
+                for p in (p0..p0 + len).rev() {
+                    let xp = *yp.at(p)
+                        - f.g[p].mul(&(f.u1[p].cast::<f64>() * x1 + f.u2[p].cast::<f64>() * x2));
+                    *ep.at(p) += xp;
+                    x2 = x1;
+                    x1 = xp;
+                }
+            }
+        });
+    }
+}
+
+/// `dst = srcᵀ` for a field stored as `rows` × `cols` (row-major) into `cols` × `rows`:
+/// particles row by row to column by column. Blocked, so both sides stay in cache; parallel
+/// over blocks of destination rows.
+fn transpose<T: Copy + Send + Sync>(src: &[T], dst: &mut [T], cols: usize, rows: usize) {
+    const B: usize = 16;
+    debug_assert_eq!(src.len(), rows * cols);
+    let dp = SyncPtr(dst.as_mut_ptr());
+    let bands = cols.div_ceil(B);
+    for_each_index(bands, rows * cols >= PAR_MIN, |band| {
+        let (c0, c1) = (band * B, ((band + 1) * B).min(cols));
+        for r0 in (0..rows).step_by(B) {
+            let r1 = (r0 + B).min(rows);
+            for c in c0..c1 {
+                for r in r0..r1 {
+                    // SAFETY: destination rows c0..c1 belong to this band alone.
+                    unsafe { *dp.at(c * rows + r) = src[r * cols + c] };
+                }
+            }
+        }
+    });
 }
