@@ -338,7 +338,7 @@ fn sweep_lines(
                     };
                     // symmetric elimination: L(p, p−1) = U(p−1, p)ᵀ G(p−1); the scratch
                     // holds w = G y, so the multiplier is never stored
-                    if p >= p0 + 1 {
+                    if p > p0 {
                         d -= f.u1[p - 1].cast::<f64>().tr_mul(&*yp.at(p - 1));
                     }
                     if p >= p0 + 2 {
