@@ -31,11 +31,19 @@ struct Factors {
     /// `NONE`.
     prev1: Vec<usize>,
     prev2: Vec<usize>,
-    /// Inverse pivots (single precision: a preconditioner, bounded by memory traffic).
-    g: Vec<Sym3f>,
-    /// Upper blocks to the next and the one after.
-    u1: Vec<Mat3f>,
-    u2: Vec<Mat3f>,
+    /// Each particle's factor blocks, together: the sweeps stream one array, not three.
+    blk: Vec<LineFactor>,
+}
+
+/// One particle's blocks of a line factorisation (single precision: a preconditioner,
+/// bounded by memory traffic).
+#[derive(Debug, Clone, Copy)]
+struct LineFactor {
+    /// Inverse pivot.
+    g: Sym3f,
+    /// Upper blocks to the next particle and the one after.
+    u1: Mat3f,
+    u2: Mat3f,
 }
 
 /// Factorised line systems of one grid for both directions, plus scratch.
@@ -89,13 +97,17 @@ impl LineSolver {
                     }
                 }
             }
-            let z = vec![Mat3f::zeros(); n];
             Factors {
                 prev1,
                 prev2,
-                g: vec![Sym3f::default(); n],
-                u1: z.clone(),
-                u2: z,
+                blk: vec![
+                    LineFactor {
+                        g: Sym3f::default(),
+                        u1: Mat3f::zeros(),
+                        u2: Mat3f::zeros(),
+                    };
+                    n
+                ],
             }
         };
         let warp = factors(LineDir::Warp);
@@ -153,11 +165,7 @@ impl LineSolver {
                 ),
             };
             let rows = Self::rows(a, dir);
-            let (gp, u1p, u2p) = (
-                SyncPtr(f.g.as_mut_ptr()),
-                SyncPtr(f.u1.as_mut_ptr()),
-                SyncPtr(f.u2.as_mut_ptr()),
-            );
+            let fp = SyncPtr(f.blk.as_mut_ptr());
             let (prev1, prev2) = (&f.prev1, &f.prev2);
             // block (p, p − back) of the line system, zero when either particle is fixed
             let blk = |p: usize, back: usize, slot: usize| {
@@ -222,9 +230,11 @@ impl LineSolver {
                     // SAFETY: each particle belongs to exactly one line of this direction.
                     unsafe {
                         // W is a Schur complement of a symmetric matrix: G is symmetric
-                        *gp.at(p) = Sym3f::from_upper(&g);
-                        *u1p.at(p) = u1.cast::<f32>();
-                        *u2p.at(p) = u2.cast::<f32>();
+                        *fp.at(p) = LineFactor {
+                            g: Sym3f::from_upper(&g),
+                            u1: u1.cast::<f32>(),
+                            u2: u2.cast::<f32>(),
+                        };
                     }
                     (g_2, u1_2, u2_2) = (g_1, u1_1, u2_1);
                     (g_1, u1_1, u2_1) = (g, u1, u2);
@@ -339,17 +349,19 @@ fn sweep_lines(
                     // symmetric elimination: L(p, p−1) = U(p−1, p)ᵀ G(p−1); the scratch
                     // holds w = G y, so the multiplier is never stored
                     if p > p0 {
-                        d -= f.u1[p - 1].cast::<f64>().tr_mul(&*yp.at(p - 1));
+                        d -= f.blk[p - 1].u1.cast::<f64>().tr_mul(&*yp.at(p - 1));
                     }
                     if p >= p0 + 2 {
-                        d -= f.u2[p - 2].cast::<f64>().tr_mul(&*yp.at(p - 2));
+                        d -= f.blk[p - 2].u2.cast::<f64>().tr_mul(&*yp.at(p - 2));
                     }
-                    *yp.at(p) = f.g[p].mul(&d);
+                    *yp.at(p) = f.blk[p].g.mul(&d);
                 }
                 let (mut x1, mut x2) = (Vec3::zeros(), Vec3::zeros());
                 for p in (p0..p0 + len).rev() {
+                    let b = &f.blk[p];
                     let xp = *yp.at(p)
-                        - f.g[p].mul(&(f.u1[p].cast::<f64>() * x1 + f.u2[p].cast::<f64>() * x2));
+                        - b.g
+                            .mul(&(b.u1.cast::<f64>() * x1 + b.u2.cast::<f64>() * x2));
                     *ep.at(p) += xp;
                     x2 = x1;
                     x1 = xp;
