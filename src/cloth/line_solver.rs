@@ -6,12 +6,14 @@
 //! share an element), so lines of one colour are solved in parallel, one task per line. Weft
 //! lines work in the weft numbering (particles column by column): they read the matrix's
 //! permuted mirror and copies of the residual, correction, fixed flags and penalties permuted
-//! the same way (blocked transposes in and out of each sweep), so in either direction a line
-//! is a run of consecutive particles and every array streams through memory. No allocation
-//! per step.
+//! the same way (blocked transposes; a V-cycle level transposes in once before its
+//! pre-smoothing weft sweep and out once after its post-smoothing one, forming its residual and
+//! taking the coarse correction in the weft numbering between them), so in either direction a
+//! line is a run of consecutive particles and every array streams through memory. No
+//! allocation per step.
 
 use super::bcsr::{Bcsr3, Mat3f, Rows32, Sym3f};
-use super::parallel::{for_each_index, SyncPtr, PAR_MIN};
+use super::parallel::{for_each_index, for_each_mut, SyncPtr, PAR_MIN};
 use crate::geometry::{Mat3, Vec3};
 
 /// Which family of grid lines.
@@ -66,7 +68,7 @@ const NONE: usize = usize::MAX;
 
 /// Stored row `p` of the weft-ordered mirror is particle `order[p]`: weft lines one after the
 /// other.
-fn weft_order(nx: usize, ny: usize) -> Vec<u32> {
+pub(crate) fn weft_order(nx: usize, ny: usize) -> Vec<u32> {
     (0..nx * ny)
         .map(|p| ((p % ny) * nx + p / ny) as u32)
         .collect()
@@ -303,6 +305,68 @@ impl LineSolver {
                 transpose(&self.e_weft, e, ny, nx);
             }
         }
+    }
+}
+
+/// The weft-numbered copies of the residual and the correction that a V-cycle level keeps
+/// between its pre- and post-smoothing weft sweeps, so that each is transposed once per
+/// visit instead of around every sweep.
+impl LineSolver {
+    /// Copies `r` and `e` into the weft numbering.
+    pub fn enter_weft(&mut self, r: &[Vec3], e: &[Vec3]) {
+        let (nx, ny) = (self.nx, self.ny);
+        transpose(r, &mut self.r_weft, nx, ny);
+        transpose(e, &mut self.e_weft, nx, ny);
+    }
+
+    /// Copies the weft-numbered correction back into `e` (row numbering).
+    pub fn leave_weft(&self, e: &mut [Vec3]) {
+        transpose(&self.e_weft, e, self.ny, self.nx);
+    }
+
+    /// One weft sweep, as [`LineSolver::sweep`], on the weft-numbered copies made by
+    /// [`LineSolver::enter_weft`]; `penalized` says whether the penalty last given to
+    /// [`LineSolver::factor`] applies.
+    pub fn sweep_weft(&mut self, a: &Bcsr3, penalized: bool, order: [usize; 3]) {
+        let (nl, len) = self.lines(LineDir::Weft);
+        sweep_lines(
+            &self.weft,
+            Self::rows(a, LineDir::Weft),
+            nl,
+            len,
+            &mut self.y,
+            &self.r_weft,
+            &mut self.e_weft,
+            &self.fixed_weft,
+            penalized.then_some(&self.pen_weft[..]),
+            order,
+            false,
+        );
+    }
+
+    /// `d = r − (A + pen) e` in the weft numbering (zero at fixed particles), from the
+    /// weft-numbered copies.
+    pub fn residual_weft(&self, a: &Bcsr3, penalized: bool, d: &mut [Vec3]) {
+        let rows = Self::rows(a, LineDir::Weft);
+        let (r, e, fixed, pen) = (&self.r_weft, &self.e_weft, &self.fixed_weft, &self.pen_weft);
+        let par = d.len() >= PAR_MIN;
+        for_each_mut(d, par, |p, out| {
+            *out = if fixed[p] {
+                Vec3::zeros()
+            } else {
+                // SAFETY: `e` holds one vector per stored row and nobody writes it meanwhile.
+                let mut dp = r[p] - unsafe { rows.row_times_ptr(p, e.as_ptr()) };
+                if penalized {
+                    dp -= pen[p].mul(&e[p]);
+                }
+                dp
+            };
+        });
+    }
+
+    /// The weft-numbered correction and fixed flags, for a prolongation in that numbering.
+    pub fn weft_correction(&mut self) -> (&mut [Vec3], &[bool]) {
+        (&mut self.e_weft, &self.fixed_weft)
     }
 }
 

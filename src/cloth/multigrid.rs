@@ -8,7 +8,7 @@
 use super::assembly::{Assembly, AssemblyInputs};
 use super::bcsr::{Bcsr3, Sym3f};
 use super::constraints::{Filter, ParticleFilter};
-use super::line_solver::{LineDir, LineSolver};
+use super::line_solver::{weft_order, LineDir, LineSolver};
 use super::model::ClothModel;
 use super::parallel::{for_each_mut, PAR_MIN};
 use super::ClothError;
@@ -72,6 +72,24 @@ impl Transfer {
         Transfer { taps, rev_ptr, rev }
     }
 
+    /// The same transfer with the fine particles renumbered: fine position `p` is particle
+    /// `order[p]`.
+    fn permuted_fine(&self, order: &[u32]) -> Self {
+        let mut inv = vec![0u32; order.len()];
+        for (p, &i) in order.iter().enumerate() {
+            inv[i as usize] = p as u32;
+        }
+        Transfer {
+            taps: order.iter().map(|&i| self.taps[i as usize]).collect(),
+            rev_ptr: self.rev_ptr.clone(),
+            rev: self
+                .rev
+                .iter()
+                .map(|&(f, w)| (inv[f as usize], w))
+                .collect(),
+        }
+    }
+
     /// fine += P coarse
     fn prolong_add(&self, coarse: &[Vec3], fine: &mut [Vec3], fixed: &[bool]) {
         let par = fine.len() >= PAR_MIN;
@@ -124,7 +142,9 @@ struct Level {
     pen_dir: Vec<Vec3>,
     pen: Vec<Sym3f>,
     penalized: bool,
-    /// Transfer from the next coarser level to this one.
+    /// Transfer from the next coarser level to this one, this level's particles in the weft
+    /// numbering (where its residual is formed and its correction lives between the two
+    /// weft sweeps).
     to_fine: Option<Transfer>,
     /// Sampling of this level's state from the next finer level (coarse levels only).
     sample: Vec<[(u32, f64); 4]>,
@@ -188,8 +208,7 @@ impl Multigrid {
             asm.jacobi = false;
             let nc = cx * cy;
             let lines = LineSolver::new(&mut asm.a, cx, cy);
-            levels.last_mut().expect("level").to_fine = None;
-            let to_fine = Transfer::new((fx, fy), (cx, cy));
+            let to_fine = Transfer::new((fx, fy), (cx, cy)).permuted_fine(&weft_order(fx, fy));
             levels.last_mut().expect("level").to_fine = Some(to_fine);
             levels.push(Level {
                 model: Some(cm),
@@ -297,123 +316,98 @@ impl Multigrid {
     }
 
     fn vcycle(&mut self, l: usize, a0: &Bcsr3) {
-        let last = l + 1 == self.levels.len();
-        let passes = if last { COARSE_SWEEPS } else { 1 };
+        if l + 1 == self.levels.len() {
+            self.coarsest(l, a0);
+            return;
+        }
         {
             let lv = &mut self.levels[l];
             let a = match &lv.asm {
                 Some(asm) => &asm.a,
                 None => a0,
             };
+            let pen = lv.penalized.then_some(&lv.pen[..]);
             lv.e.fill(Vec3::zeros());
-            // pre-smoothing: warp lines, then weft lines, colours forward
-            for p in 0..passes {
-                lv.lines.sweep(
-                    a,
-                    LineDir::Warp,
-                    &lv.r,
-                    &mut lv.e,
-                    &lv.fixed,
-                    lv.penalized.then_some(&lv.pen[..]),
-                    FORWARD,
-                    p == 0,
-                );
-                lv.lines.sweep(
-                    a,
-                    LineDir::Weft,
-                    &lv.r,
-                    &mut lv.e,
-                    &lv.fixed,
-                    lv.penalized.then_some(&lv.pen[..]),
-                    FORWARD,
-                    false,
-                );
-            }
-            if !last {
-                residual(
-                    a,
-                    &lv.r,
-                    &lv.e,
-                    &mut lv.d,
-                    &lv.fixed,
-                    lv.penalized.then_some(&lv.pen[..]),
-                );
-            }
-        }
-        if !last {
-            {
-                let (fine, coarse) = self.levels.split_at_mut(l + 1);
-                let (f, c) = (&fine[l], &mut coarse[0]);
-                f.to_fine
-                    .as_ref()
-                    .expect("transfer")
-                    .restrict(&f.d, &mut c.r, &c.fixed);
-            }
-            self.vcycle(l + 1, a0);
-            let (fine, coarse) = self.levels.split_at_mut(l + 1);
-            let (f, c) = (&mut fine[l], &coarse[0]);
-            f.to_fine
-                .as_ref()
-                .expect("transfer")
-                .prolong_add(&c.e, &mut f.e, &f.fixed);
-        }
-        let lv = &mut self.levels[l];
-        let a = match &lv.asm {
-            Some(asm) => &asm.a,
-            None => a0,
-        };
-        // post-smoothing, the adjoint of the pre-smoothing: weft then warp, colours backward
-        for _ in 0..passes {
-            lv.lines.sweep(
-                a,
-                LineDir::Weft,
-                &lv.r,
-                &mut lv.e,
-                &lv.fixed,
-                lv.penalized.then_some(&lv.pen[..]),
-                BACKWARD,
-                false,
-            );
+            // pre-smoothing: warp lines, then weft lines, colours forward; the weft sweep,
+            // the residual and the transfers work in the weft numbering
             lv.lines.sweep(
                 a,
                 LineDir::Warp,
                 &lv.r,
                 &mut lv.e,
                 &lv.fixed,
-                lv.penalized.then_some(&lv.pen[..]),
-                BACKWARD,
-                false,
+                pen,
+                FORWARD,
+                true,
             );
+            lv.lines.enter_weft(&lv.r, &lv.e);
+            lv.lines.sweep_weft(a, lv.penalized, FORWARD);
+            lv.lines.residual_weft(a, lv.penalized, &mut lv.d);
+        }
+        {
+            let (fine, coarse) = self.levels.split_at_mut(l + 1);
+            let (f, c) = (&fine[l], &mut coarse[0]);
+            f.to_fine
+                .as_ref()
+                .expect("transfer")
+                .restrict(&f.d, &mut c.r, &c.fixed);
+        }
+        self.vcycle(l + 1, a0);
+        let (fine, coarse) = self.levels.split_at_mut(l + 1);
+        let (lv, c) = (&mut fine[l], &coarse[0]);
+        let (e_weft, fixed_weft) = lv.lines.weft_correction();
+        lv.to_fine
+            .as_ref()
+            .expect("transfer")
+            .prolong_add(&c.e, e_weft, fixed_weft);
+        let a = match &lv.asm {
+            Some(asm) => &asm.a,
+            None => a0,
+        };
+        // post-smoothing, the adjoint of the pre-smoothing: weft then warp, colours backward
+        lv.lines.sweep_weft(a, lv.penalized, BACKWARD);
+        lv.lines.leave_weft(&mut lv.e);
+        let pen = lv.penalized.then_some(&lv.pen[..]);
+        lv.lines.sweep(
+            a,
+            LineDir::Warp,
+            &lv.r,
+            &mut lv.e,
+            &lv.fixed,
+            pen,
+            BACKWARD,
+            false,
+        );
+    }
+
+    /// The coarsest level of a V-cycle: symmetric alternating line sweeps only.
+    fn coarsest(&mut self, l: usize, a0: &Bcsr3) {
+        let lv = &mut self.levels[l];
+        let a = match &lv.asm {
+            Some(asm) => &asm.a,
+            None => a0,
+        };
+        let pen = lv.penalized.then_some(&lv.pen[..]);
+        lv.e.fill(Vec3::zeros());
+        for p in 0..COARSE_SWEEPS {
+            let (r, e) = (&lv.r, &mut lv.e);
+            lv.lines
+                .sweep(a, LineDir::Warp, r, e, &lv.fixed, pen, FORWARD, p == 0);
+            lv.lines
+                .sweep(a, LineDir::Weft, r, e, &lv.fixed, pen, FORWARD, false);
+        }
+        for _ in 0..COARSE_SWEEPS {
+            let (r, e) = (&lv.r, &mut lv.e);
+            lv.lines
+                .sweep(a, LineDir::Weft, r, e, &lv.fixed, pen, BACKWARD, false);
+            lv.lines
+                .sweep(a, LineDir::Warp, r, e, &lv.fixed, pen, BACKWARD, false);
         }
     }
 }
 
 const FORWARD: [usize; 3] = [0, 1, 2];
 const BACKWARD: [usize; 3] = [2, 1, 0];
-
-/// d = r − (A + pen) e, zero at fixed particles.
-fn residual(
-    a: &Bcsr3,
-    r: &[Vec3],
-    e: &[Vec3],
-    d: &mut [Vec3],
-    fixed: &[bool],
-    pen: Option<&[Sym3f]>,
-) {
-    let par = d.len() >= PAR_MIN;
-    for_each_mut(d, par, |i, out| {
-        *out = if fixed[i] {
-            Vec3::zeros()
-        } else {
-            // SAFETY: `e` is a live slice of `a.rows()` vectors that nobody writes meanwhile.
-            let mut di = r[i] - unsafe { a.row_times32_ptr(i, e.as_ptr()) };
-            if let Some(p) = pen {
-                di -= p[i].mul(&e[i]);
-            }
-            di
-        };
-    });
-}
 
 /// Penalty stiffness of a constrained direction relative to the particle's own diagonal.
 const PENALTY: f64 = 1e3;
