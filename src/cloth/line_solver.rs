@@ -283,26 +283,14 @@ impl LineSolver {
                 );
             }
             LineDir::Weft => {
-                transpose(r, &mut self.r_weft, nx, ny);
-                if !from_zero {
-                    transpose(e, &mut self.e_weft, nx, ny);
-                } else {
+                if from_zero {
+                    transpose(r, &mut self.r_weft, nx, ny);
                     self.e_weft.fill(Vec3::zeros());
+                } else {
+                    self.enter_weft(r, e);
                 }
-                sweep_lines(
-                    &self.weft,
-                    rows,
-                    nl,
-                    len,
-                    &mut self.y,
-                    &self.r_weft,
-                    &mut self.e_weft,
-                    &self.fixed_weft,
-                    pen.map(|_| &self.pen_weft[..]),
-                    order,
-                    from_zero,
-                );
-                transpose(&self.e_weft, e, ny, nx);
+                self.sweep_weft(a, pen.is_some(), order, from_zero);
+                self.leave_weft(e);
             }
         }
     }
@@ -326,8 +314,8 @@ impl LineSolver {
 
     /// One weft sweep, as [`LineSolver::sweep`], on the weft-numbered copies made by
     /// [`LineSolver::enter_weft`]; `penalized` says whether the penalty last given to
-    /// [`LineSolver::factor`] applies.
-    pub fn sweep_weft(&mut self, a: &Bcsr3, penalized: bool, order: [usize; 3]) {
+    /// [`LineSolver::factor`] applies, `from_zero` that the correction is zero.
+    pub fn sweep_weft(&mut self, a: &Bcsr3, penalized: bool, order: [usize; 3], from_zero: bool) {
         let (nl, len) = self.lines(LineDir::Weft);
         sweep_lines(
             &self.weft,
@@ -340,7 +328,7 @@ impl LineSolver {
             &self.fixed_weft,
             penalized.then_some(&self.pen_weft[..]),
             order,
-            false,
+            from_zero,
         );
     }
 

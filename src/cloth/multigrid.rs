@@ -341,7 +341,7 @@ impl Multigrid {
                 true,
             );
             lv.lines.enter_weft(&lv.r, &lv.e);
-            lv.lines.sweep_weft(a, lv.penalized, FORWARD);
+            lv.lines.sweep_weft(a, lv.penalized, FORWARD, false);
             lv.lines.residual_weft(a, lv.penalized, &mut lv.d);
         }
         {
@@ -365,7 +365,7 @@ impl Multigrid {
             None => a0,
         };
         // post-smoothing, the adjoint of the pre-smoothing: weft then warp, colours backward
-        lv.lines.sweep_weft(a, lv.penalized, BACKWARD);
+        lv.lines.sweep_weft(a, lv.penalized, BACKWARD, false);
         lv.lines.leave_weft(&mut lv.e);
         let pen = lv.penalized.then_some(&lv.pen[..]);
         lv.lines.sweep(
