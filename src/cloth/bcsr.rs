@@ -352,17 +352,6 @@ impl Bcsr3 {
         }
     }
 
-    /// Row `i` of `A x` with the single-precision mirror, reading `x` through a raw pointer.
-    ///
-    /// # Safety
-    /// `x` must point to `rows()` vectors; no other thread may write the entries row `i` reads.
-    #[inline]
-    pub unsafe fn row_times32_ptr(&self, i: usize, x: *const Vec3) -> Vec3 {
-        let (s, e) = (self.row_ptr[i], self.row_ptr[i + 1]);
-        // SAFETY: forwarded from the caller.
-        unsafe { sym_row_product(&self.values32[s..e], &self.cols[s..e], x) }
-    }
-
     /// Row `i` of `A x`.
     #[inline]
     pub fn row_times(&self, i: usize, x: &[Vec3]) -> Vec3 {
@@ -435,7 +424,7 @@ mod tests {
             let (yp, yi) = unsafe {
                 (
                     rows.row_times_ptr(p, xp.as_ptr()),
-                    a.row_times32_ptr(i, x.as_ptr()),
+                    a.rows32().row_times_ptr(i, x.as_ptr()),
                 )
             };
             assert_eq!(yp, yi);
