@@ -322,10 +322,7 @@ impl Multigrid {
         }
         {
             let lv = &mut self.levels[l];
-            let a = match &lv.asm {
-                Some(asm) => &asm.a,
-                None => a0,
-            };
+            let a = operator(&lv.asm, a0);
             let pen = lv.penalized.then_some(&lv.pen[..]);
             lv.e.fill(Vec3::zeros());
             // pre-smoothing: warp lines, then weft lines, colours forward; the weft sweep,
@@ -360,10 +357,7 @@ impl Multigrid {
             .as_ref()
             .expect("transfer")
             .prolong_add(&c.e, e_weft, fixed_weft);
-        let a = match &lv.asm {
-            Some(asm) => &asm.a,
-            None => a0,
-        };
+        let a = operator(&lv.asm, a0);
         // post-smoothing, the adjoint of the pre-smoothing: weft then warp, colours backward
         lv.lines.sweep_weft(a, lv.penalized, BACKWARD, false);
         lv.lines.leave_weft(&mut lv.e);
@@ -383,10 +377,7 @@ impl Multigrid {
     /// The coarsest level of a V-cycle: symmetric alternating line sweeps only.
     fn coarsest(&mut self, l: usize, a0: &Bcsr3) {
         let lv = &mut self.levels[l];
-        let a = match &lv.asm {
-            Some(asm) => &asm.a,
-            None => a0,
-        };
+        let a = operator(&lv.asm, a0);
         let pen = lv.penalized.then_some(&lv.pen[..]);
         lv.e.fill(Vec3::zeros());
         for p in 0..COARSE_SWEEPS {
@@ -404,6 +395,11 @@ impl Multigrid {
                 .sweep(a, LineDir::Warp, r, e, &lv.fixed, pen, BACKWARD, false);
         }
     }
+}
+
+/// A level's matrix: its own assembly's, or the finest level's `a0`.
+fn operator<'a>(asm: &'a Option<Assembly>, a0: &'a Bcsr3) -> &'a Bcsr3 {
+    asm.as_ref().map_or(a0, |asm| &asm.a)
 }
 
 const FORWARD: [usize; 3] = [0, 1, 2];
