@@ -8,7 +8,7 @@
 
 use rayon::prelude::*;
 
-use super::bcsr::{Bcsr3, Sym3f};
+use super::bcsr::{Bcsr3, Sym3, Sym3f, SYM_ROW_MAX};
 use super::elements::{BendLine, SpringKind};
 use super::material::Direction;
 use super::model::ClothModel;
@@ -504,7 +504,15 @@ impl Assembly {
         let drag = model.fabric.air_drag;
         let h = inp.dt;
         let matrix = inp.matrix;
+        // general blocks in `values`, or symmetric ones in `sym` (or none, single-precision
+        // mirrors only), always with a mirror: see `Bcsr3::store_symmetric`
+        let general = !self.a.values.is_empty();
+        assert!(
+            general || !self.a.values32.is_empty(),
+            "a matrix without general blocks keeps its single-precision mirror"
+        );
         let values = SyncPtr(self.a.values.as_mut_ptr());
+        let sym = (!self.a.sym.is_empty()).then(|| SyncPtr(self.a.sym.as_mut_ptr()));
         let mirror = !self.a.values32.is_empty();
         let jacobi = self.jacobi;
         let values32 = SyncPtr(self.a.values32.as_mut_ptr());
@@ -533,29 +541,61 @@ impl Assembly {
                         rhs += g[src as usize];
                     }
                     bs[k] = rhs;
-                    if matrix {
-                        // SAFETY: row i's slots belong to this iteration only.
-                        unsafe {
-                            for s in row_ptr[i]..row_ptr[i + 1] {
+                    if !matrix {
+                        continue;
+                    }
+                    let (s0, s1) = (row_ptr[i], row_ptr[i + 1]);
+                    let dm = m + h * da;
+                    // SAFETY: row i's slots belong to this iteration only.
+                    unsafe {
+                        if general {
+                            for s in s0..s1 {
                                 *values.at(s) = Mat3::zeros();
                             }
-                            *values.at(diag[i]) = Mat3::identity() * (m + h * da);
+                            *values.at(diag[i]) = Mat3::identity() * dm;
                             for r in &recs[rec_ptr[i]..rec_ptr[i + 1]] {
                                 *values.at(r.slot as usize) += blocks[r.src as usize] * r.scale;
                             }
                             if mirror {
-                                for s in row_ptr[i]..row_ptr[i + 1] {
+                                for s in s0..s1 {
                                     *values32.at(s) = Sym3f::from_upper(&*values.at(s));
-                                }
-                                if let Some(p) = perm32 {
-                                    let at = perm_start[i];
-                                    for s in row_ptr[i]..row_ptr[i + 1] {
-                                        *p.at(at + s - row_ptr[i]) = *values32.at(s);
-                                    }
                                 }
                             }
                             if jacobi {
                                 ps[k] = block_inverse(&*values.at(diag[i]));
+                            }
+                        } else {
+                            // symmetric blocks: the row summed here, then written once to each
+                            // stored copy
+                            let mut buf = [std::mem::MaybeUninit::<Sym3>::uninit(); SYM_ROW_MAX];
+                            for b in &mut buf[..s1 - s0] {
+                                b.write(Sym3::default());
+                            }
+                            // SAFETY: the first s1 − s0 entries were just written (a row has
+                            // at most SYM_ROW_MAX blocks: `Bcsr3::store_symmetric` checked).
+                            let row = &mut *(&mut buf[..s1 - s0] as *mut [_] as *mut [Sym3]);
+                            row[diag[i] - s0] = Sym3([dm, 0.0, 0.0, dm, 0.0, dm]);
+                            for r in &recs[rec_ptr[i]..rec_ptr[i + 1]] {
+                                row[r.slot as usize - s0]
+                                    .add_scaled(&blocks[r.src as usize], r.scale);
+                            }
+                            let row = &*row;
+                            if let Some(sp) = sym {
+                                for (t, b) in row.iter().enumerate() {
+                                    *sp.at(s0 + t) = *b;
+                                }
+                            }
+                            for (t, b) in row.iter().enumerate() {
+                                *values32.at(s0 + t) = b.to_f32();
+                            }
+                            if jacobi {
+                                ps[k] = block_inverse(&row[diag[i] - s0].to_mat3());
+                            }
+                        }
+                        if let Some(p) = perm32 {
+                            let at = perm_start[i];
+                            for s in s0..s1 {
+                                *p.at(at + s - s0) = *values32.at(s);
                             }
                         }
                     }
@@ -580,7 +620,7 @@ impl Assembly {
         self.pinv
             .par_iter_mut()
             .enumerate()
-            .for_each(|(i, p)| *p = block_inverse(&a.values[a.diag[i]]));
+            .for_each(|(i, p)| *p = block_inverse(&a.block(a.diag[i])));
     }
 }
 

@@ -9,6 +9,10 @@ use crate::geometry::{Mat3, Vec3};
 /// Rows per parallel task.
 pub const ROW_CHUNK: usize = 256;
 
+/// Most blocks in one row of a matrix stored without general blocks (its rows are summed in a
+/// fixed-size local buffer): a grid cloth's rows have 13, or 21 with interlaced connections.
+pub const SYM_ROW_MAX: usize = 32;
+
 /// Block compressed-row matrix with 3×3 blocks.
 #[derive(Debug, Clone, Default)]
 pub struct Bcsr3 {
@@ -16,8 +20,13 @@ pub struct Bcsr3 {
     pub row_ptr: Vec<usize>,
     /// Block column of each stored block.
     pub cols: Vec<u32>,
-    /// Block values.
+    /// Block values (empty when the blocks are stored symmetric, in `sym`, or not at all in
+    /// double precision: see [`Bcsr3::store_symmetric`] and [`Bcsr3::store_single_only`]).
     pub values: Vec<Mat3>,
+    /// Block values as symmetric blocks, when every block is symmetric (grid cloths: springs
+    /// only) and [`Bcsr3::store_symmetric`] chose this storage: two thirds of the bytes of
+    /// `values`, which the conjugate gradient's products stream once per iteration.
+    pub sym: Vec<Sym3>,
     /// Index of the diagonal block of each row.
     pub diag: Vec<usize>,
     /// Optional single-precision mirror of `values` (empty unless enabled), read by the
@@ -192,6 +201,58 @@ unsafe fn sym_row_product_avx2(values: &[Sym3f], cols: &[u32], x: *const Vec3) -
     }
 }
 
+/// A symmetric 3×3 block in double precision: (xx, xy, xz, yy, yz, zz).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Sym3(pub [f64; 6]);
+
+impl Sym3 {
+    /// The upper triangle of `m`.
+    #[inline]
+    pub fn from_upper(m: &Mat3) -> Self {
+        Sym3([
+            m[(0, 0)],
+            m[(0, 1)],
+            m[(0, 2)],
+            m[(1, 1)],
+            m[(1, 2)],
+            m[(2, 2)],
+        ])
+    }
+
+    /// `self += m · scale`, upper triangle of `m` only.
+    #[inline]
+    pub fn add_scaled(&mut self, m: &Mat3, scale: f64) {
+        let u = Self::from_upper(m).0;
+        for (a, b) in self.0.iter_mut().zip(u) {
+            *a += b * scale;
+        }
+    }
+
+    /// The full block.
+    #[inline]
+    pub fn to_mat3(&self) -> Mat3 {
+        let [a, b, c, d, e, f] = self.0;
+        Mat3::new(a, b, c, b, d, e, c, e, f)
+    }
+
+    /// The block rounded to single precision.
+    #[inline]
+    pub fn to_f32(&self) -> Sym3f {
+        Sym3f(self.0.map(|v| v as f32))
+    }
+
+    /// `self · x`, each component summed in the order of a general block's product.
+    #[inline]
+    pub fn mul(&self, x: &Vec3) -> Vec3 {
+        let [a, b, c, d, e, f] = self.0;
+        Vec3::new(
+            a * x.x + b * x.y + c * x.z,
+            b * x.x + d * x.y + e * x.z,
+            c * x.x + e * x.y + f * x.z,
+        )
+    }
+}
+
 /// 3×3 single-precision block.
 pub type Mat3f = nalgebra::Matrix3<f32>;
 
@@ -261,6 +322,7 @@ impl Bcsr3 {
             row_ptr,
             cols,
             values,
+            sym: Vec::new(),
             diag,
             values32: Vec::new(),
             permuted: None,
@@ -299,7 +361,54 @@ impl Bcsr3 {
     /// Allocates the single-precision symmetric mirror (filled by whoever fills `values`;
     /// only valid when every block is symmetric, as on grid cloths).
     pub fn enable_mirror32(&mut self) {
-        self.values32 = vec![Sym3f::default(); self.values.len()];
+        self.values32 = vec![Sym3f::default(); self.cols.len()];
+    }
+
+    /// Stores the double-precision blocks as symmetric blocks (`sym`) instead of general ones
+    /// (`values`, emptied), with the single-precision mirror (enabled here). Only for matrices
+    /// whose blocks are all symmetric (grid cloths): whoever fills the matrix keeps the upper
+    /// triangles. Returns false, changing nothing, when a row has more than [`SYM_ROW_MAX`]
+    /// blocks.
+    pub fn store_symmetric(&mut self) -> bool {
+        if !self.rows_fit_symmetric() {
+            return false;
+        }
+        if self.values32.is_empty() {
+            self.enable_mirror32();
+        }
+        self.sym = vec![Sym3::default(); self.cols.len()];
+        self.values = Vec::new();
+        true
+    }
+
+    /// Keeps no double-precision blocks at all, only the single-precision mirror (enabled
+    /// here): for the coarse levels of a multigrid hierarchy, which only its smoother reads.
+    /// [`Bcsr3::row_times`] and [`Bcsr3::block`] must not be used on such a matrix. Returns
+    /// false, changing nothing, when a row has more than [`SYM_ROW_MAX`] blocks.
+    pub fn store_single_only(&mut self) -> bool {
+        if !self.rows_fit_symmetric() {
+            return false;
+        }
+        if self.values32.is_empty() {
+            self.enable_mirror32();
+        }
+        self.sym = Vec::new();
+        self.values = Vec::new();
+        true
+    }
+
+    fn rows_fit_symmetric(&self) -> bool {
+        self.row_ptr.windows(2).all(|w| w[1] - w[0] <= SYM_ROW_MAX)
+    }
+
+    /// Block `k` (as stored in `values` or `sym`).
+    #[inline]
+    pub fn block(&self, k: usize) -> Mat3 {
+        if self.sym.is_empty() {
+            self.values[k]
+        } else {
+            self.sym[k].to_mat3()
+        }
     }
 
     /// Allocates a second single-precision mirror whose stored row `p` is row `order[p]`
@@ -356,8 +465,15 @@ impl Bcsr3 {
     #[inline]
     pub fn row_times(&self, i: usize, x: &[Vec3]) -> Vec3 {
         let mut acc = Vec3::zeros();
-        for k in self.row_ptr[i]..self.row_ptr[i + 1] {
-            acc += self.values[k] * x[self.cols[k] as usize];
+        let (s, e) = (self.row_ptr[i], self.row_ptr[i + 1]);
+        if self.sym.is_empty() {
+            for k in s..e {
+                acc += self.values[k] * x[self.cols[k] as usize];
+            }
+        } else {
+            for (b, &c) in self.sym[s..e].iter().zip(&self.cols[s..e]) {
+                acc += b.mul(&x[c as usize]);
+            }
         }
         acc
     }

@@ -179,10 +179,14 @@ impl Multigrid {
         };
         let (w, h) = grid_extent(model, nx, ny);
         let n = nx * ny;
+        let lines = LineSolver::new(a, nx, ny);
+        // a grid's blocks are symmetric: the conjugate gradient's products then stream two
+        // thirds of the bytes (rows too long for that keep general blocks)
+        a.store_symmetric();
         let mut levels = vec![Level {
             model: None,
             asm: None,
-            lines: LineSolver::new(a, nx, ny),
+            lines,
             fixed: vec![false; n],
             pen_dir: vec![Vec3::zeros(); n],
             pen: vec![Sym3f::default(); n],
@@ -208,6 +212,8 @@ impl Multigrid {
             asm.jacobi = false;
             let nc = cx * cy;
             let lines = LineSolver::new(&mut asm.a, cx, cy);
+            // only the smoother reads a coarse level's matrix, in single precision
+            asm.a.store_single_only();
             let to_fine = Transfer::new((fx, fy), (cx, cy)).permuted_fine(&weft_order(fx, fy));
             levels.last_mut().expect("level").to_fine = Some(to_fine);
             levels.push(Level {

@@ -89,7 +89,7 @@ impl PcgWorkspace {
             for (i, zi) in z.iter().enumerate() {
                 if *zi != Vec3::zeros() {
                     for k in a.row_ptr[i]..a.row_ptr[i + 1] {
-                        q[a.cols[k] as usize] += a.values[k].transpose() * zi;
+                        q[a.cols[k] as usize] += a.block(k).transpose() * zi;
                     }
                 }
             }
