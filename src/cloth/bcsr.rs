@@ -285,12 +285,7 @@ impl Sym3f {
     /// `self · x`, accumulated in double precision.
     #[inline]
     pub fn mul(&self, x: &Vec3) -> Vec3 {
-        let [a, b, c, d, e, f] = self.0.map(f64::from);
-        Vec3::new(
-            a * x.x + b * x.y + c * x.z,
-            b * x.x + d * x.y + e * x.z,
-            c * x.x + e * x.y + f * x.z,
-        )
+        Sym3(self.0.map(f64::from)).mul(x)
     }
 }
 
