@@ -345,7 +345,8 @@ impl Multigrid {
             );
             lv.lines.enter_weft(&lv.r, &lv.e);
             lv.lines.sweep_weft(a, lv.penalized, FORWARD, false);
-            lv.lines.residual_weft(a, lv.penalized, &mut lv.d);
+            lv.lines
+                .residual_weft(a, lv.penalized, FORWARD[2], &mut lv.d);
         }
         {
             let (fine, coarse) = self.levels.split_at_mut(l + 1);
