@@ -12,7 +12,7 @@ use super::bcsr::{Bcsr3, Sym3, Sym3f, SYM_ROW_MAX};
 use super::elements::{BendLine, SpringKind};
 use super::material::Direction;
 use super::model::ClothModel;
-use super::parallel::{chunks, ordered_sum, SyncPtr, CHUNK};
+use super::parallel::{chunks, ordered_sum, stream_copy, stream_fence, SyncPtr, CHUNK};
 use crate::geometry::{Mat3, Vec3};
 
 /// One matrix contribution: `values[slot] += scale · blocks[src]`.
@@ -581,16 +581,21 @@ impl Assembly {
                             }
                             let row = &*row;
                             if let Some(sp) = sym {
-                                for (t, b) in row.iter().enumerate() {
-                                    *sp.at(s0 + t) = *b;
-                                }
+                                stream_copy(sp.at(s0), row);
                             }
-                            for (t, b) in row.iter().enumerate() {
-                                *values32.at(s0 + t) = b.to_f32();
+                            let mut buf32 = [Sym3f::default(); SYM_ROW_MAX];
+                            for (o, b) in buf32.iter_mut().zip(row) {
+                                *o = b.to_f32();
+                            }
+                            let row32 = &buf32[..s1 - s0];
+                            stream_copy(values32.at(s0), row32);
+                            if let Some(p) = perm32 {
+                                stream_copy(p.at(perm_start[i]), row32);
                             }
                             if jacobi {
                                 ps[k] = block_inverse(&row[diag[i] - s0].to_mat3());
                             }
+                            continue;
                         }
                         if let Some(p) = perm32 {
                             let at = perm_start[i];
@@ -600,6 +605,7 @@ impl Assembly {
                         }
                     }
                 }
+                stream_fence();
             });
         debug_assert_eq!(self.b.len(), n);
     }
