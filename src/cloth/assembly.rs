@@ -512,7 +512,7 @@ impl Assembly {
             "a matrix without general blocks keeps its single-precision mirror"
         );
         let values = SyncPtr(self.a.values.as_mut_ptr());
-        let sym = (!self.a.sym.is_empty()).then(|| SyncPtr(self.a.sym.as_mut_ptr()));
+        let sym = (!self.a.sym.is_empty()).then_some(SyncPtr(self.a.sym.as_mut_ptr()));
         let mirror = !self.a.values32.is_empty();
         let jacobi = self.jacobi;
         let values32 = SyncPtr(self.a.values32.as_mut_ptr());

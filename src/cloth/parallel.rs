@@ -85,7 +85,7 @@ pub unsafe fn stream_copy<T: Copy>(dst: *mut T, src: &[T]) {
     let bytes = std::mem::size_of_val(src);
     #[cfg(target_arch = "x86_64")]
     {
-        if bytes % 8 == 0 && (dst as usize) % 8 == 0 {
+        if bytes.is_multiple_of(8) && (dst as usize).is_multiple_of(8) {
             use std::arch::x86_64::_mm_stream_si64;
             let (d, s) = (dst as *mut i64, src.as_ptr() as *const i64);
             for k in 0..bytes / 8 {
