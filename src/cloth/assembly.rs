@@ -564,6 +564,12 @@ impl Assembly {
                             if jacobi {
                                 ps[k] = block_inverse(&*values.at(diag[i]));
                             }
+                            if let Some(p) = perm32 {
+                                let at = perm_start[i];
+                                for s in s0..s1 {
+                                    *p.at(at + s - s0) = *values32.at(s);
+                                }
+                            }
                         } else {
                             // symmetric blocks: the row summed here, then written once to each
                             // stored copy
@@ -594,13 +600,6 @@ impl Assembly {
                             }
                             if jacobi {
                                 ps[k] = block_inverse(&row[diag[i] - s0].to_mat3());
-                            }
-                            continue;
-                        }
-                        if let Some(p) = perm32 {
-                            let at = perm_start[i];
-                            for s in s0..s1 {
-                                *p.at(at + s - s0) = *values32.at(s);
                             }
                         }
                     }
