@@ -15,13 +15,22 @@ use super::model::ClothModel;
 use super::parallel::{chunks, ordered_sum, stream_copy, stream_fence, SyncPtr, CHUNK};
 use crate::geometry::{Mat3, Vec3};
 
-/// One matrix contribution: `values[slot] += scale · blocks[src]`.
+/// One matrix contribution: `values[slot] += scale · block src`, the scale kept apart (see
+/// [`Assembly`]'s `rec_scale`). Eight bytes, not sixteen: the gather streams one record per
+/// (row, element, column).
 #[derive(Debug, Clone, Copy)]
 struct Rec {
     slot: u32,
+    /// Index into the symmetric blocks, or, from `hinge_block0` on, into the hinge blocks.
     src: u32,
-    scale: f64,
 }
+
+/// A record's scale index meaning "not in the table: see `scale_spill`".
+const SPILL: u8 = u8::MAX;
+
+/// Marks a right-hand-side record whose contribution is subtracted: a two-node element
+/// stores its first node's contribution only, the second node's being its opposite.
+const NEG: u32 = 1 << 31;
 
 /// Preallocated buffers and the contribution records of a model's topology.
 #[derive(Debug, Clone)]
@@ -35,9 +44,21 @@ pub struct Assembly {
     pub pinv: Vec<Mat3>,
     /// Whether assembly forms `pinv` (not needed while multigrid preconditions).
     pub jacobi: bool,
-    blocks: Vec<Mat3>,
+    /// Stiffness blocks of springs, shear diagonals and bending lines (all symmetric).
+    blocks: Vec<Sym3>,
+    /// Stiffness blocks of hinges (16 per hinge, general).
+    hinge_blocks: Vec<Mat3>,
+    /// Right-hand-side contributions: one per spring and shear diagonal (its first node's;
+    /// the second node's is the opposite), one per node of a bending line or hinge.
     g: Vec<Vec3>,
     recs: Vec<Rec>,
+    /// Each record's scale, as an index into `scales` (a model has a handful of distinct
+    /// scales: ±1 and the products of its bending lines' coefficients), or [`SPILL`].
+    rec_scale: Vec<u8>,
+    scales: Vec<f64>,
+    /// Every record's scale, kept only when the model has more distinct scales than the table
+    /// holds.
+    scale_spill: Vec<f64>,
     rec_ptr: Vec<usize>,
     grecs: Vec<u32>,
     grec_ptr: Vec<usize>,
@@ -88,43 +109,37 @@ impl Assembly {
         let quad_block0 = ns;
         let bend_block0 = ns + 2 * nq;
         let hinge_block0 = bend_block0 + nb;
-        let quad_g0 = 2 * ns;
-        let bend_g0 = quad_g0 + 4 * nq;
+        let quad_g0 = ns;
+        let bend_g0 = quad_g0 + 2 * nq;
         let hinge_g0 = bend_g0 + 3 * nb;
-        let mut rows: Vec<Vec<Rec>> = vec![Vec::new(); n];
+        let mut rows: Vec<Vec<(Rec, f64)>> = vec![Vec::new(); n];
         let mut grows: Vec<Vec<u32>> = vec![Vec::new(); n];
         let slot = |i: usize, j: usize| a.slot(i, j).expect("pair in pattern") as u32;
+        let rec = |slot: u32, src: usize, scale: f64| {
+            (
+                Rec {
+                    slot,
+                    src: src as u32,
+                },
+                scale,
+            )
+        };
         for (s, sp) in model.springs.iter().enumerate() {
-            for (me, other, gi) in [(sp.a, sp.b, 2 * s), (sp.b, sp.a, 2 * s + 1)] {
-                rows[me].push(Rec {
-                    slot: slot(me, me),
-                    src: s as u32,
-                    scale: 1.0,
-                });
-                rows[me].push(Rec {
-                    slot: slot(me, other),
-                    src: s as u32,
-                    scale: -1.0,
-                });
-                grows[me].push(gi as u32);
+            for (me, other, sign) in [(sp.a, sp.b, 0), (sp.b, sp.a, NEG)] {
+                rows[me].push(rec(slot(me, me), s, 1.0));
+                rows[me].push(rec(slot(me, other), s, -1.0));
+                grows[me].push(s as u32 | sign);
             }
         }
         for (q, quad) in model.shear_quads.iter().enumerate() {
             for k in 0..2 {
                 let (a, b) = (quad.nodes[2 * k], quad.nodes[2 * k + 1]);
-                let src = (quad_block0 + 2 * q + k) as u32;
-                for (me, other, gi) in [(a, b, 4 * q + 2 * k), (b, a, 4 * q + 2 * k + 1)] {
-                    rows[me].push(Rec {
-                        slot: slot(me, me),
-                        src,
-                        scale: 1.0,
-                    });
-                    rows[me].push(Rec {
-                        slot: slot(me, other),
-                        src,
-                        scale: -1.0,
-                    });
-                    grows[me].push((quad_g0 + gi) as u32);
+                let src = quad_block0 + 2 * q + k;
+                let gi = (quad_g0 + 2 * q + k) as u32;
+                for (me, other, sign) in [(a, b, 0), (b, a, NEG)] {
+                    rows[me].push(rec(slot(me, me), src, 1.0));
+                    rows[me].push(rec(slot(me, other), src, -1.0));
+                    grows[me].push(gi | sign);
                 }
             }
         }
@@ -132,11 +147,8 @@ impl Assembly {
             for m in 0..3 {
                 let me = bl.nodes[m];
                 for k in 0..3 {
-                    rows[me].push(Rec {
-                        slot: slot(me, bl.nodes[k]),
-                        src: (bend_block0 + e) as u32,
-                        scale: bl.coef[m] * bl.coef[k],
-                    });
+                    let scale = bl.coef[m] * bl.coef[k];
+                    rows[me].push(rec(slot(me, bl.nodes[k]), bend_block0 + e, scale));
                 }
                 grows[me].push((bend_g0 + 3 * e + m) as u32);
             }
@@ -145,26 +157,29 @@ impl Assembly {
             for m in 0..4 {
                 let me = hg.nodes[m];
                 for k in 0..4 {
-                    rows[me].push(Rec {
-                        slot: slot(me, hg.nodes[k]),
-                        src: (hinge_block0 + 16 * h + 4 * m + k) as u32,
-                        scale: 1.0,
-                    });
+                    let src = hinge_block0 + 16 * h + 4 * m + k;
+                    rows[me].push(rec(slot(me, hg.nodes[k]), src, 1.0));
                 }
                 grows[me].push((hinge_g0 + 4 * h + m) as u32);
             }
         }
         let (recs, rec_ptr) = flatten(rows);
         let (grecs, grec_ptr) = flatten(grows);
+        let (rec_scale, scales, scale_spill) = scale_table(&recs);
+        let recs = recs.into_iter().map(|(r, _)| r).collect();
         let n_elems = ns + nq + nb + nh;
         Assembly {
             a,
             b: vec![Vec3::zeros(); n],
             pinv: vec![Mat3::identity(); n],
             jacobi: true,
-            blocks: vec![Mat3::zeros(); ns + 2 * nq + nb + 16 * nh],
-            g: vec![Vec3::zeros(); 2 * ns + 4 * nq + 3 * nb + 4 * nh],
+            blocks: vec![Sym3::default(); hinge_block0],
+            hinge_blocks: vec![Mat3::zeros(); 16 * nh],
+            g: vec![Vec3::zeros(); hinge_g0 + 4 * nh],
             recs,
+            rec_scale,
+            scales,
+            scale_spill,
             rec_ptr,
             grecs,
             grec_ptr,
@@ -240,7 +255,8 @@ impl Assembly {
         let nbc = chunks(nb, CHUNK);
         let (blocks_s, rest) = self.blocks.split_at_mut(self.quad_block0);
         let (blocks_q, rest) = rest.split_at_mut(self.bend_block0 - self.quad_block0);
-        let (blocks_b, blocks_h) = rest.split_at_mut(self.hinge_block0 - self.bend_block0);
+        let blocks_b = rest;
+        let blocks_h = &mut self.hinge_blocks[..];
         let (g_s, rest) = self.g.split_at_mut(self.quad_g0);
         let (g_q, rest) = rest.split_at_mut(self.bend_g0 - self.quad_g0);
         let (g_b, g_h) = rest.split_at_mut(self.hinge_g0 - self.bend_g0);
@@ -269,7 +285,7 @@ impl Assembly {
             .springs
             .par_chunks(CHUNK)
             .zip(blocks_s.par_chunks_mut(CHUNK))
-            .zip(g_s.par_chunks_mut(2 * CHUNK))
+            .zip(g_s.par_chunks_mut(CHUNK))
             .zip(ep_s.par_iter_mut())
             .enumerate()
             .for_each(|(c, (((sp, bl), g), ep))| {
@@ -298,10 +314,9 @@ impl Assembly {
                         let kmat = ev.stiffness();
                         ga += kmat * rel * hk;
                         let c = ev.dir * ev.dir.transpose() * (beta_s * axial_el);
-                        bl[k] = kmat * hk + c * inp.dt;
+                        bl[k] = Sym3::from_upper(&(kmat * hk + c * inp.dt));
                     }
-                    g[2 * k] = ga;
-                    g[2 * k + 1] = -ga;
+                    g[k] = ga;
                 }
                 *ep = e;
             });
@@ -310,7 +325,7 @@ impl Assembly {
             .shear_quads
             .par_chunks(CHUNK)
             .zip(blocks_q.par_chunks_mut(2 * CHUNK))
-            .zip(g_q.par_chunks_mut(4 * CHUNK))
+            .zip(g_q.par_chunks_mut(2 * CHUNK))
             .zip(ep_q.par_iter_mut())
             .enumerate()
             .for_each(|(c, (((qs, bl), g), ep))| {
@@ -349,10 +364,9 @@ impl Assembly {
                             let kmat = axial * dhs.max(0.0)
                                 + Mat3::identity() * (q.area * hs * gk).max(0.0);
                             ga += kmat * rel * hk;
-                            bl[2 * k + m] = kmat * hk + cdamp * inp.dt;
+                            bl[2 * k + m] = Sym3::from_upper(&(kmat * hk + cdamp * inp.dt));
                         }
-                        g[4 * k + 2 * m] = ga;
-                        g[4 * k + 2 * m + 1] = -ga;
+                        g[2 * k + m] = ga;
                     }
                 }
                 *ep = e;
@@ -418,7 +432,7 @@ impl Assembly {
                         g[3 * k + m] = (forces[m] - dw * cm) * hf - sw * (cm * hk);
                     }
                     if matrix {
-                        bl[k] = s * hk + s_el * (inp.dt * beta_b);
+                        bl[k] = Sym3::from_upper(&(s * hk + s_el * (inp.dt * beta_b)));
                     }
                 }
                 *ep = e;
@@ -523,7 +537,13 @@ impl Assembly {
         let (row_ptr, diag) = (&self.a.row_ptr, &self.a.diag);
         let (recs, rec_ptr, grecs, grec_ptr) =
             (&self.recs, &self.rec_ptr, &self.grecs, &self.grec_ptr);
-        let (blocks, g) = (&self.blocks, &self.g);
+        let (rec_scale, scales, spill) = (&self.rec_scale, &self.scales, &self.scale_spill);
+        let scale = |k: usize| match rec_scale[k] {
+            SPILL => spill[k],
+            t => scales[t as usize],
+        };
+        let (blocks, hinge_blocks, g) = (&self.blocks, &self.hinge_blocks, &self.g);
+        let nsym = self.hinge_block0;
         self.b
             .par_chunks_mut(CHUNK)
             .zip(self.pinv.par_chunks_mut(CHUNK))
@@ -538,7 +558,11 @@ impl Assembly {
                         rhs *= h;
                     }
                     for &src in &grecs[grec_ptr[i]..grec_ptr[i + 1]] {
-                        rhs += g[src as usize];
+                        if src & NEG == 0 {
+                            rhs += g[src as usize];
+                        } else {
+                            rhs -= g[(src & !NEG) as usize];
+                        }
                     }
                     bs[k] = rhs;
                     if !matrix {
@@ -553,8 +577,14 @@ impl Assembly {
                                 *values.at(s) = Mat3::zeros();
                             }
                             *values.at(diag[i]) = Mat3::identity() * dm;
-                            for r in &recs[rec_ptr[i]..rec_ptr[i + 1]] {
-                                *values.at(r.slot as usize) += blocks[r.src as usize] * r.scale;
+                            for k in rec_ptr[i]..rec_ptr[i + 1] {
+                                let (r, src) = (recs[k], recs[k].src as usize);
+                                let blk = if src < nsym {
+                                    blocks[src].to_mat3()
+                                } else {
+                                    hinge_blocks[src - nsym]
+                                };
+                                *values.at(r.slot as usize) += blk * scale(k);
                             }
                             if mirror {
                                 for s in s0..s1 {
@@ -581,9 +611,14 @@ impl Assembly {
                             // at most SYM_ROW_MAX blocks: `Bcsr3::store_symmetric` checked).
                             let row = &mut *(&mut buf[..s1 - s0] as *mut [_] as *mut [Sym3]);
                             row[diag[i] - s0] = Sym3([dm, 0.0, 0.0, dm, 0.0, dm]);
-                            for r in &recs[rec_ptr[i]..rec_ptr[i + 1]] {
-                                row[r.slot as usize - s0]
-                                    .add_scaled(&blocks[r.src as usize], r.scale);
+                            for k in rec_ptr[i]..rec_ptr[i + 1] {
+                                let (r, src) = (recs[k], recs[k].src as usize);
+                                let to = &mut row[r.slot as usize - s0];
+                                if src < nsym {
+                                    to.add_scaled_sym(&blocks[src], scale(k));
+                                } else {
+                                    to.add_scaled(&hinge_blocks[src - nsym], scale(k));
+                                }
                             }
                             let row = &*row;
                             if let Some(sp) = sym {
@@ -636,6 +671,27 @@ fn block_inverse(d: &Mat3) -> Mat3 {
         .unwrap_or_else(|| Mat3::identity() / d.trace().max(1e-300))
 }
 
+/// The records' scales as indices into a table of the distinct ones (compared bit for bit),
+/// or, when there are more than the indices can name, all of them spilled to a plain array.
+fn scale_table(recs: &[(Rec, f64)]) -> (Vec<u8>, Vec<f64>, Vec<f64>) {
+    let mut table: Vec<f64> = Vec::new();
+    let mut idx = Vec::with_capacity(recs.len());
+    for &(_, s) in recs {
+        match table.iter().position(|t| t.to_bits() == s.to_bits()) {
+            Some(k) => idx.push(k as u8),
+            None if table.len() < SPILL as usize => {
+                idx.push(table.len() as u8);
+                table.push(s);
+            }
+            None => {
+                let spill = recs.iter().map(|&(_, s)| s).collect();
+                return (vec![SPILL; recs.len()], Vec::new(), spill);
+            }
+        }
+    }
+    (idx, table, Vec::new())
+}
+
 /// Concatenates per-row lists into one array plus row offsets.
 fn flatten<T>(rows: Vec<Vec<T>>) -> (Vec<T>, Vec<usize>) {
     let mut ptr = vec![0];
@@ -645,4 +701,37 @@ fn flatten<T>(rows: Vec<Vec<T>>) -> (Vec<T>, Vec<usize>) {
         ptr.push(flat.len());
     }
     (flat, ptr)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn recs(scales: &[f64]) -> Vec<(Rec, f64)> {
+        scales
+            .iter()
+            .map(|&s| (Rec { slot: 0, src: 0 }, s))
+            .collect()
+    }
+
+    #[test]
+    fn scale_table_names_each_distinct_scale_once() {
+        let s = [1.0, -1.0, 0.25, 1.0, -0.0, 0.0, 0.25];
+        let (idx, table, spill) = scale_table(&recs(&s));
+        assert!(spill.is_empty());
+        // 0.0 and −0.0 differ bit for bit, so both are kept
+        assert_eq!(table.len(), 5);
+        for (k, &v) in s.iter().enumerate() {
+            assert_eq!(table[idx[k] as usize].to_bits(), v.to_bits());
+        }
+    }
+
+    #[test]
+    fn scale_table_spills_when_scales_outnumber_the_indices() {
+        let s: Vec<f64> = (0..300).map(|k| 1.0 + k as f64).collect();
+        let (idx, table, spill) = scale_table(&recs(&s));
+        assert!(table.is_empty());
+        assert!(idx.iter().all(|&i| i == SPILL));
+        assert_eq!(spill, s);
+    }
 }

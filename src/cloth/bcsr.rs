@@ -228,6 +228,14 @@ impl Sym3 {
         }
     }
 
+    /// `self += m · scale`.
+    #[inline]
+    pub fn add_scaled_sym(&mut self, m: &Sym3, scale: f64) {
+        for (a, b) in self.0.iter_mut().zip(m.0) {
+            *a += b * scale;
+        }
+    }
+
     /// The full block.
     #[inline]
     pub fn to_mat3(&self) -> Mat3 {
