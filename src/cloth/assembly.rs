@@ -2,9 +2,11 @@
 //! `A = M − h ∂f/∂v − h² ∂f/∂x` and `b = h (f + h ∂f/∂x v)` (Baraff & Witkin 1998).
 //!
 //! Two deterministic parallel passes, no allocation: (1) every element writes its per-node
-//! right-hand-side contributions and its stiffness blocks into its own slots of flat buffers;
-//! (2) every matrix row gathers them, in a fixed order, through contribution records built once
-//! per topology. The block-Jacobi preconditioner (inverse diagonal blocks) is formed in pass 2.
+//! right-hand-side contributions (a two-node element only its first node's: the second takes
+//! the opposite) and its stiffness blocks (symmetric, except a hinge's) into its own slots of
+//! flat buffers; (2) every matrix row gathers them, in a fixed order, through contribution
+//! records built once per topology. The block-Jacobi preconditioner (inverse diagonal blocks)
+//! is formed in pass 2.
 
 use rayon::prelude::*;
 
