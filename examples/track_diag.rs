@@ -71,7 +71,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let vv: Vec<_> = views
         .views
         .iter()
-        .map(|v| (&v[0].camera, &v[0].image))
+        .map(|v| (&v[0].camera, &v[0].image, Some(v[0].active.as_slice())))
         .collect();
     let (colours, seen) = learn_colours(&mesh, &ws.skinned, &vv);
     println!(

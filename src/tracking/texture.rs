@@ -3,7 +3,9 @@
 //! where it is visible (z-buffer test) and weighted by how squarely each camera sees it
 //! (cos² of the angle between the surface normal and the line of sight). Vertices no camera
 //! sees take the mean of their mesh neighbours (repeated diffusion), so the puppet has no
-//! holes where it was hidden on the first frame.
+//! holes where it was hidden on the first frame. Pixels a view marks as unusable (where a
+//! static occluder stands in front of the person) give no colour: a limb behind an
+//! occluder in one camera takes its colour from the cameras that see it.
 
 use super::camera::Camera;
 use super::puppet_mesh::TrackingMesh;
@@ -33,12 +35,12 @@ pub fn vertex_normals(positions: &[Vec3], triangles: &[[u32; 3]], out: &mut Vec<
 }
 
 /// Learns one colour per vertex of `mesh`, posed at `skinned`, from the views
-/// (camera and image at the same resolution). Returns the colours and how many vertices at
-/// least one camera saw.
+/// (camera, image at the same resolution and, optionally, which of its pixels may be used).
+/// Returns the colours and how many vertices at least one camera saw.
 pub fn learn_colours(
     mesh: &TrackingMesh,
     skinned: &[Vec3],
-    views: &[(&Camera, &Level)],
+    views: &[(&Camera, &Level, Option<&[bool]>)],
 ) -> (Vec<[f32; 3]>, usize) {
     let n = skinned.len();
     let mut normals = Vec::new();
@@ -47,7 +49,7 @@ pub fn learn_colours(
     let mut weight = vec![0.0f64; n];
     let mut projected = Vec::with_capacity(n);
     let grey = vec![[0.0f32; 3]; n];
-    for (camera, image) in views {
+    for &(camera, image, usable) in views {
         project_vertices(camera, skinned, &mut projected);
         let mut target = RasterTarget::new(image.width, image.height);
         draw_triangles(&mut target, &projected, &grey, &mesh.triangles);
@@ -76,7 +78,9 @@ pub fn learn_colours(
                     }
                 }
             }
-            if z > nearest + VISIBILITY_TOLERANCE {
+            if z > nearest + VISIBILITY_TOLERANCE
+                || usable.is_some_and(|u| !u[py * image.width + px])
+            {
                 continue;
             }
             let to_cam = Vec3::new(centre.x, centre.y, centre.z) - skinned[v];
@@ -164,5 +168,75 @@ fn fill_unseen(mesh: &TrackingMesh, weight: &[f64], colours: &mut [[f32; 3]]) {
         if !known[v] {
             colours[v] = s.map(|x| (x / c) as f32);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tracking::puppet::PartGroup;
+    use nalgebra::Vector3;
+
+    /// A 0.4 m square at z = 0 facing +z, as two outward-wound triangles.
+    fn square() -> (TrackingMesh, Vec<Vec3>) {
+        let rest = vec![
+            Vec3::new(-0.2, -0.2, 0.0),
+            Vec3::new(0.2, -0.2, 0.0),
+            Vec3::new(0.2, 0.2, 0.0),
+            Vec3::new(-0.2, 0.2, 0.0),
+        ];
+        let mesh = TrackingMesh {
+            rest: rest.clone(),
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+            bone: vec![0; 4],
+            part: vec![PartGroup::Torso; 4],
+            source: vec![0; 4],
+            lbs_bones: vec![[0; 4]; 4],
+            lbs_weights: vec![[1.0, 0.0, 0.0, 0.0]; 4],
+        };
+        (mesh, rest)
+    }
+
+    fn flat(colour: [f32; 3]) -> Level {
+        Level {
+            width: 64,
+            height: 64,
+            rgb: vec![colour; 64 * 64],
+        }
+    }
+
+    #[test]
+    fn pixels_marked_unusable_give_no_colour() {
+        // regression: the tracker's texture took the colours of static occluders standing in
+        // front of a limb in some cameras, so the limb was not recognised where it was seen
+        let (mesh, skinned) = square();
+        let a = Camera::looking_at(Vector3::new(0.0, 0.0, 2.0), Vector3::zeros(), 80.0, 64, 64);
+        let b = Camera::looking_at(Vector3::new(0.3, 0.0, 2.0), Vector3::zeros(), 80.0, 64, 64);
+        let (red, blue) = (flat([200.0, 0.0, 0.0]), flat([0.0, 0.0, 200.0]));
+        let hidden = vec![false; 64 * 64];
+        let (colours, seen) = learn_colours(
+            &mesh,
+            &skinned,
+            &[(&a, &red, None), (&b, &blue, Some(&hidden))],
+        );
+        assert_eq!(seen, 4);
+        for c in &colours {
+            assert_eq!(
+                *c,
+                [200.0, 0.0, 0.0],
+                "colour {c:?} mixes in the unusable view"
+            );
+        }
+        // both views usable: every vertex mixes the two colours
+        let (colours, _) = learn_colours(&mesh, &skinned, &[(&a, &red, None), (&b, &blue, None)]);
+        for c in &colours {
+            assert!(
+                c[0] > 50.0 && c[2] > 50.0,
+                "colour {c:?} should mix both views"
+            );
+        }
+        // no usable view: nothing seen
+        let (_, seen) = learn_colours(&mesh, &skinned, &[(&b, &blue, Some(&hidden))]);
+        assert_eq!(seen, 0);
     }
 }

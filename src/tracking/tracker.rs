@@ -390,7 +390,7 @@ impl Tracker {
             .views
             .views
             .iter()
-            .map(|v| (&v[0].camera, &v[0].image))
+            .map(|v| (&v[0].camera, &v[0].image, Some(v[0].active.as_slice())))
             .collect();
         let (colours, seen) = learn_colours(&self.mesh, &ws.skinned, &views);
         drop(ws);
