@@ -79,7 +79,7 @@ pub fn learn_colours(
                 }
             }
             if z > nearest + VISIBILITY_TOLERANCE
-                || usable.is_some_and(|u| !u[py * image.width + px])
+                || usable.is_some_and(|u| u.get(py * image.width + px) != Some(&true))
             {
                 continue;
             }
