@@ -6,6 +6,7 @@ pub mod aggregation;
 pub mod amg;
 pub mod assembly;
 pub mod bcsr;
+pub mod buckling_side;
 pub mod choi_ko;
 pub mod compression_release;
 pub mod constraints;

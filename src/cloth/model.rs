@@ -3,6 +3,7 @@
 
 use std::sync::Arc;
 
+use super::buckling_side::FlexionSide;
 use super::elements::{BendLine, Hinge, ShearQuad, Spring, SpringKind};
 use super::material::{Direction, FabricParameters, MaterialLaw};
 use super::ClothError;
@@ -34,6 +35,11 @@ pub struct ClothModel {
     pub grid: Option<(usize, usize)>,
     /// Whether Choi & Ko's buckling model is on (see [`ClothModel::enable_choi_ko`]).
     pub choi_ko: bool,
+    /// Choi–Ko's connections as the choice of their buckling side sees them (see
+    /// [`super::buckling_side`]); empty without Choi–Ko.
+    pub flexion_sides: Vec<FlexionSide>,
+    /// Seed of the random side a flat Choi–Ko connection buckles to.
+    pub choi_ko_seed: u64,
 }
 
 impl ClothModel {
@@ -120,6 +126,8 @@ impl ClothModel {
             fabric,
             grid: Some((nx, ny)),
             choi_ko: false,
+            flexion_sides: Vec::new(),
+            choi_ko_seed: 1,
         })
     }
 
@@ -211,6 +219,8 @@ impl ClothModel {
             fabric,
             grid: None,
             choi_ko: false,
+            flexion_sides: Vec::new(),
+            choi_ko_seed: 1,
         })
     }
 
@@ -240,8 +250,27 @@ impl ClothModel {
             )
         };
         for e in std::mem::take(&mut self.bend_lines) {
-            let [a, _, c] = e.nodes;
+            let [a, b, c] = e.nodes;
             let (len, _) = dist(a, c);
+            // the middle's neighbour across the line (grids only carry bending lines)
+            if let Some((nx, ny)) = self.grid {
+                let (i, j) = (b / nx, b % nx);
+                let other = match e.dir {
+                    Direction::Warp if i + 1 < ny => Some(b + nx),
+                    Direction::Warp if i > 0 => Some(b - nx),
+                    Direction::Weft if j + 1 < nx => Some(b + 1),
+                    Direction::Weft if j > 0 => Some(b - 1),
+                    _ => None,
+                };
+                if let Some(o) = other {
+                    self.flexion_sides.push(FlexionSide {
+                        ends: [a, c],
+                        middle: [b, b],
+                        across: [b, o],
+                        rest: len,
+                    });
+                }
+            }
             self.springs.push(Spring {
                 a,
                 b: c,
@@ -258,9 +287,15 @@ impl ClothModel {
             .partition(|h| h.seam);
         self.hinges = seams;
         for h in fabric {
-            let [_, _, c, d] = h.nodes;
+            let [e0, e1, c, d] = h.nodes;
             let (len, warp_weight) = dist(c, d);
             if len > 0.0 {
+                self.flexion_sides.push(FlexionSide {
+                    ends: [c, d],
+                    middle: [e0, e1],
+                    across: [e0, e1],
+                    rest: len,
+                });
                 self.springs.push(Spring {
                     a: c,
                     b: d,

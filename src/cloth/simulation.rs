@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use super::amg::AggregationMultigrid;
 use super::assembly::{Assembly, AssemblyInputs};
+use super::buckling_side::BucklingSides;
 use super::constraints::{Attachment, ContactHook, Filter, Obstacles, ParticleFilter, Trajectory};
 use super::model::ClothModel;
 use super::multigrid::Multigrid;
@@ -118,6 +119,8 @@ impl SimulationParameters {
 pub struct Simulation {
     /// The fixed model.
     pub model: ClothModel,
+    /// The side each flat Choi–Ko connection buckles to (with Choi–Ko only).
+    pub sides: Option<BucklingSides>,
     /// The changing state.
     pub state: ClothState,
     /// Settings.
@@ -176,7 +179,10 @@ impl Simulation {
         }
         let mut contact = Collisions::default();
         contact.set_cloth(&model.mesh.triangles, &model.mesh.positions);
+        let sides = (model.choi_ko && !model.flexion_sides.is_empty())
+            .then(|| BucklingSides::new(model.flexion_sides.clone(), model.choi_ko_seed));
         Ok(Simulation {
+            sides,
             contact,
             impulse: vec![Vec3::zeros(); n],
             x_step: vec![Vec3::zeros(); n],
@@ -381,6 +387,12 @@ impl Simulation {
                 };
                 self.contact.set_zones(zones);
             }
+        }
+        if let Some(sides) = &mut self.sides {
+            let attachments = &self.attachments;
+            sides.start_arcs(&mut self.state.x, |i| {
+                attachments.iter().any(|a| a.particles.contains(&i))
+            });
         }
         self.x_save.copy_from_slice(&self.state.x);
         self.v_save.copy_from_slice(&self.state.v);

@@ -208,11 +208,30 @@ pub fn register(engine: &mut Engine) {
         engine,
         "with_choi_ko",
         ["cloth: Cloth", "Cloth"],
-        "A copy of the cloth with Choi & Ko's buckling model: compressed springs give way to the
-buckling force of their fabric, and bending is carried by interlaced connections (two apart
-along grid lines, or across each pair of triangles) that buckle into arcs.",
+        "A copy of the cloth with Choi & Ko's buckling model: bending is carried by interlaced
+connections (two apart along grid lines, or across each pair of triangles) that buckle into
+arcs when compressed, pushing their ends apart with the arc's force; stretch springs keep the
+measured law. A connection compressed in a perfectly flat cloth bulges to a side drawn from
+seed 1 (see `with_choi_ko(seed)`).",
         |c: &mut ClothHandle| -> RResult<ClothHandle> {
             let mut m = (*c.0).clone();
+            m.enable_choi_ko();
+            Ok(ClothHandle(Shared::new(m)))
+        }
+    );
+    register!(
+        engine,
+        "with_choi_ko",
+        ["cloth: Cloth", "seed: int", "Cloth"],
+        "A copy of the cloth with Choi & Ko's buckling model (see `with_choi_ko()`), a connection
+compressed in a perfectly flat cloth bulging to a side drawn from `seed`: the same seed gives
+the same wrinkles bit for bit, another may flip them.",
+        |c: &mut ClothHandle, seed: INT| -> RResult<ClothHandle> {
+            if seed < 0 {
+                return Err(rt_err(format!("with_choi_ko: seed must be ≥ 0, got {seed}")));
+            }
+            let mut m = (*c.0).clone();
+            m.choi_ko_seed = seed as u64;
             m.enable_choi_ko();
             Ok(ClothHandle(Shared::new(m)))
         }

@@ -1,0 +1,151 @@
+//! The side a Choi–Ko connection buckles to. Choi & Ko's connection is taken to have bent at
+//! once into an arc when compressed, but its force acts along the chord and says nothing of
+//! the arc's side: a perfectly flat cloth pushed in its plane (all particles in one plane, to
+//! the last bit) gets no force out of that plane, so it stays flat and either keeps its
+//! springs compressed or folds over itself within its plane. Where a compressed connection's
+//! middle lies on its chord exactly (within 1e-12 of its rest length, round-off), this module
+//! chooses the side the arc bulges to by a seeded random draw, as the compression-release
+//! model breaks its ties (seed report §5.4.4.1.2), and starts the arc there: the middle moves
+//! by 1e-6 of the rest length along the cloth's normal. The dynamics take it from there; a
+//! cloth already out of its plane is never touched, and the same seed gives the same result
+//! bit for bit.
+
+use crate::geometry::{SplitMix64, Vec3};
+
+/// A Choi–Ko connection's geometry for choosing its side.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FlexionSide {
+    /// The connection's two ends.
+    pub ends: [usize; 2],
+    /// The particles between them: the middle particle twice on a grid line, the shared edge
+    /// of two triangles on a mesh.
+    pub middle: [usize; 2],
+    /// Two particles whose difference crosses the connection within the cloth (the middle and
+    /// its neighbour across the grid line; the shared edge on a mesh).
+    pub across: [usize; 2],
+    /// Rest length of the connection (m).
+    pub rest: f64,
+}
+
+/// Below this offset of the middle from the chord (relative to the rest length) the arc has no
+/// side yet.
+pub const FLAT: f64 = 1e-12;
+/// How far (relative to the rest length) the middle is moved to start the arc on its side.
+pub const START: f64 = 1e-6;
+
+/// The connections and the random draws.
+#[derive(Debug, Clone)]
+pub struct BucklingSides {
+    sides: Vec<FlexionSide>,
+    rng: SplitMix64,
+    /// Arcs started so far.
+    pub started: u64,
+}
+
+impl BucklingSides {
+    /// The sides of `sides`, drawn from `seed`.
+    pub fn new(sides: Vec<FlexionSide>, seed: u64) -> Self {
+        BucklingSides {
+            sides,
+            rng: SplitMix64::new(seed),
+            started: 0,
+        }
+    }
+
+    /// Starts the arc of every compressed connection whose middle lies on its chord, moving
+    /// the middle particles (except those `held`) along the cloth's normal to a side drawn
+    /// at random. Returns how many arcs were started.
+    pub fn start_arcs(&mut self, x: &mut [Vec3], held: impl Fn(usize) -> bool) -> usize {
+        let mut started = 0;
+        for s in &self.sides {
+            let [a, b] = s.ends;
+            let chord = x[b] - x[a];
+            if chord.norm() >= s.rest {
+                continue;
+            }
+            let across = x[s.across[1]] - x[s.across[0]];
+            let normal = chord.cross(&across);
+            let nn = normal.norm();
+            if nn <= 0.0 {
+                continue;
+            }
+            let normal = normal / nn;
+            let mid = 0.5 * (x[s.middle[0]] + x[s.middle[1]]);
+            let offset = (mid - 0.5 * (x[a] + x[b])).dot(&normal);
+            if offset.abs() > FLAT * s.rest {
+                continue;
+            }
+            let up = self.rng.next_u64() & 1 == 1;
+            let shift = normal * if up { START * s.rest } else { -START * s.rest };
+            let [m0, m1] = s.middle;
+            if !held(m0) {
+                x[m0] += shift;
+            }
+            if m1 != m0 && !held(m1) {
+                x[m1] += shift;
+            }
+            started += 1;
+        }
+        self.started += started as u64;
+        started
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn line(squeeze: f64) -> Vec<Vec3> {
+        // a three-particle line along x and a neighbour across it, all at z = 0
+        vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(0.01 * squeeze, 0.0, 0.0),
+            Vec3::new(0.02 * squeeze, 0.0, 0.0),
+            Vec3::new(0.01 * squeeze, 0.01, 0.0),
+        ]
+    }
+
+    fn side() -> FlexionSide {
+        FlexionSide {
+            ends: [0, 2],
+            middle: [1, 1],
+            across: [1, 3],
+            rest: 0.02,
+        }
+    }
+
+    #[test]
+    fn a_flat_compressed_connection_starts_its_arc_out_of_the_plane() {
+        let mut x = line(0.95);
+        let mut s = BucklingSides::new(vec![side()], 3);
+        assert_eq!(s.start_arcs(&mut x, |_| false), 1);
+        assert!((x[1].z.abs() - START * 0.02).abs() < 1e-15 && x[1].x == 0.01 * 0.95);
+        // now it has a side: nothing more to do
+        assert_eq!(s.start_arcs(&mut x, |_| false), 0);
+    }
+
+    #[test]
+    fn seeds_choose_both_sides_and_repeat_themselves() {
+        let draw = |seed| {
+            let mut x = line(0.95);
+            BucklingSides::new(vec![side()], seed).start_arcs(&mut x, |_| false);
+            x[1].z
+        };
+        let sides: Vec<f64> = (0..16).map(draw).collect();
+        assert!(sides.iter().any(|&z| z > 0.0) && sides.iter().any(|&z| z < 0.0));
+        assert_eq!(draw(7).to_bits(), draw(7).to_bits());
+    }
+
+    #[test]
+    fn slack_bent_or_held_connections_are_left_alone() {
+        let mut s = BucklingSides::new(vec![side()], 1);
+        let mut slack = line(1.0);
+        assert_eq!(s.start_arcs(&mut slack, |_| false), 0);
+        let mut bent = line(0.95);
+        bent[1].z = 1e-9;
+        assert_eq!(s.start_arcs(&mut bent, |_| false), 0);
+        let mut held = line(0.95);
+        assert_eq!(s.start_arcs(&mut held, |i| i == 1), 1);
+        assert_eq!(held[1].z, 0.0);
+    }
+}
