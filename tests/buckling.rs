@@ -284,7 +284,10 @@ fn choi_ko_flat_square_buckles_to_the_seeded_side_regression() {
     // the same seed gives the same wrinkles bit for bit, other seeds other wrinkles
     let run = |tag: &str, seed: &str| {
         let (l, dir) = buckle_square(tag, &[("imperfection", "0.0"), ("seed", seed)]);
-        (l[1].clone(), std::fs::read(dir.join("choi_ko.obj")).unwrap())
+        (
+            l[1].clone(),
+            std::fs::read(dir.join("choi_ko.obj")).unwrap(),
+        )
     };
     let (a, obj_a) = run("ck_seed_a", "3");
     let (_, obj_b) = run("ck_seed_b", "3");
@@ -377,4 +380,21 @@ fn wrinkle_wavelength_grows_as_the_fourth_root_of_bending_rigidity() {
         assert!((slope - 0.25).abs() < 0.06, "{model}: λ ∝ B^{slope}");
         assert!(dir.join(format!("{model}.png")).exists());
     }
+}
+
+#[test]
+fn choi_ko_wrinkle_wavelength_grows_with_bending_rigidity_regression() {
+    // Choi–Ko's connections used to read the fabric's stretch as less bending and push the
+    // membrane apart with at least 12 B/L² wherever the cloth was bent: the wrinkles then kept
+    // about 8.5 grid spacings whatever B (0.070 / 0.070 / 0.075 m, λ ∝ B^0.03). With the arc
+    // as long as the fabric (`cloth::arc_connection`) they follow B again (theory: B^0.25).
+    let (l, _) = run_script("wrinkle_wavelength", "choi_ko", &[("model", "choi_ko")]);
+    for x in &l {
+        eprintln!("{x}");
+    }
+    assert_eq!(l.len(), 3, "{l:?}");
+    let lambda: Vec<f64> = l.iter().map(|x| field(x, ", wavelength")).collect();
+    assert!(lambda[0] < lambda[1] && lambda[1] < lambda[2], "{lambda:?}");
+    let slope = (lambda[2] / lambda[0]).ln() / 16f64.ln();
+    assert!(slope > 0.15, "Choi–Ko: λ ∝ B^{slope}");
 }

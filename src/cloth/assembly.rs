@@ -155,12 +155,18 @@ impl Assembly {
                 grows[me].push((bend_g0 + 3 * e + m) as u32);
             }
         }
-        for (h, hg) in model.hinges.iter().enumerate() {
+        // hinges, then Choi–Ko's arc connections (general blocks after the hinges')
+        let four = model
+            .hinges
+            .iter()
+            .map(|h| h.nodes)
+            .chain(model.arcs.iter().map(|c| c.nodes));
+        for (h, nodes) in four.enumerate() {
             for m in 0..4 {
-                let me = hg.nodes[m];
+                let me = nodes[m];
                 for k in 0..4 {
                     let src = hinge_block0 + 16 * h + 4 * m + k;
-                    rows[me].push(rec(slot(me, hg.nodes[k]), src, 1.0));
+                    rows[me].push(rec(slot(me, nodes[k]), src, 1.0));
                 }
                 grows[me].push((hinge_g0 + 4 * h + m) as u32);
             }
@@ -169,15 +175,16 @@ impl Assembly {
         let (grecs, grec_ptr) = flatten(grows);
         let (rec_scale, scales, scale_spill) = scale_table(&recs);
         let recs = recs.into_iter().map(|(r, _)| r).collect();
-        let n_elems = ns + nq + nb + nh;
+        let na = model.arcs.len();
+        let n_elems = ns + nq + nb + nh + na;
         Assembly {
             a,
             b: vec![Vec3::zeros(); n],
             pinv: vec![Mat3::identity(); n],
             jacobi: true,
             blocks: vec![Sym3::default(); hinge_block0],
-            hinge_blocks: vec![Mat3::zeros(); 16 * nh],
-            g: vec![Vec3::zeros(); hinge_g0 + 4 * nh],
+            hinge_blocks: vec![Mat3::zeros(); 16 * (nh + na)],
+            g: vec![Vec3::zeros(); hinge_g0 + 4 * (nh + na)],
             recs,
             rec_scale,
             scales,
@@ -191,7 +198,7 @@ impl Assembly {
             quad_g0,
             bend_g0,
             hinge_g0,
-            energy_partials: vec![0.0; chunks(n_elems.max(1), CHUNK) + 4],
+            energy_partials: vec![0.0; chunks(n_elems.max(1), CHUNK) + 5],
             fric_spring: Vec::new(),
             fric_quad: Vec::new(),
             fric_bend: Vec::new(),
@@ -258,13 +265,16 @@ impl Assembly {
         let (blocks_s, rest) = self.blocks.split_at_mut(self.quad_block0);
         let (blocks_q, rest) = rest.split_at_mut(self.bend_block0 - self.quad_block0);
         let blocks_b = rest;
-        let blocks_h = &mut self.hinge_blocks[..];
+        let nh = model.hinges.len();
+        let (blocks_h, blocks_a) = self.hinge_blocks.split_at_mut(16 * nh);
         let (g_s, rest) = self.g.split_at_mut(self.quad_g0);
         let (g_q, rest) = rest.split_at_mut(self.bend_g0 - self.quad_g0);
-        let (g_b, g_h) = rest.split_at_mut(self.hinge_g0 - self.bend_g0);
+        let (g_b, rest) = rest.split_at_mut(self.hinge_g0 - self.bend_g0);
+        let (g_h, g_a) = rest.split_at_mut(4 * nh);
         let (ep_s, rest) = self.energy_partials.split_at_mut(nsc);
         let (ep_q, rest) = rest.split_at_mut(nqc);
-        let (ep_b, ep_h) = rest.split_at_mut(nbc);
+        let (ep_b, rest) = rest.split_at_mut(nbc);
+        let (ep_h, ep_a) = rest.split_at_mut(chunks(nh, CHUNK));
         let matrix = inp.matrix;
         let friction = !self.fric_spring.is_empty();
         let fr_warp = law.tension_friction(Direction::Warp).filter(|_| friction);
@@ -512,7 +522,64 @@ impl Assembly {
                 });
             ordered_sum(&ep_h[..chunks(model.hinges.len(), CHUNK)])
         };
-        ordered_sum(&ep_s[..nsc]) + ordered_sum(&ep_q[..nqc]) + ordered_sum(&ep_b[..nbc]) + hinge_e
+        // Choi–Ko's arc connections: the stable part axial · ∇l ∇lᵀ, stretch damping
+        let arc_e: f64 = if model.arcs.is_empty() {
+            0.0
+        } else {
+            model
+                .arcs
+                .par_chunks(CHUNK)
+                .zip(blocks_a.par_chunks_mut(16 * CHUNK))
+                .zip(g_a.par_chunks_mut(4 * CHUNK))
+                .zip(ep_a.par_iter_mut())
+                .for_each(|(((els, bl), g), ep)| {
+                    let mut e = 0.0;
+                    for k in 0..els.len() {
+                        let el = &els[k];
+                        let Some(ev) = el.eval(law, x) else {
+                            for m in 0..4 {
+                                g[4 * k + m] = Vec3::zeros();
+                                for q in 0..4 {
+                                    bl[16 * k + 4 * m + q] = Mat3::zeros();
+                                }
+                            }
+                            continue;
+                        };
+                        e += ev.energy;
+                        let grad = ev.grad;
+                        // the matrix's part of the gradient: along the chord, on the ends
+                        let gc = [-ev.chord, ev.chord, Vec3::zeros(), Vec3::zeros()];
+                        let rate: f64 = (0..4).map(|m| grad[m].dot(&v[el.nodes[m]])).sum();
+                        let rate_c = ev.chord.dot(&(v[el.nodes[1]] - v[el.nodes[0]]));
+                        let force = (ev.tension + beta_s * ev.axial * rate) * hf;
+                        let kv = ev.axial * rate_c * hk;
+                        let kc = ev.axial * (hk + beta_s * inp.dt);
+                        // the arc's bending stiffness acts on the middle's offset from the
+                        // ends' midpoint, m − (a + c)/2: weights −½, −½, ½, ½
+                        const W: [f64; 4] = [-0.5, -0.5, 0.5, 0.5];
+                        let vr =
+                            (v[el.nodes[2]] + v[el.nodes[3]] - v[el.nodes[0]] - v[el.nodes[1]])
+                                * 0.5;
+                        let mv = ev.middle * vr * hk;
+                        for m in 0..4 {
+                            g[4 * k + m] = -grad[m] * force - gc[m] * kv - mv * W[m];
+                            if matrix {
+                                for q in 0..4 {
+                                    bl[16 * k + 4 * m + q] = gc[m] * gc[q].transpose() * kc
+                                        + ev.middle * (W[m] * W[q] * hk);
+                                }
+                            }
+                        }
+                    }
+                    *ep = e;
+                });
+            ordered_sum(&ep_a[..chunks(model.arcs.len(), CHUNK)])
+        };
+        ordered_sum(&ep_s[..nsc])
+            + ordered_sum(&ep_q[..nqc])
+            + ordered_sum(&ep_b[..nbc])
+            + hinge_e
+            + arc_e
     }
 
     fn gather_pass(&mut self, model: &ClothModel, v: &[Vec3], inp: AssemblyInputs) {

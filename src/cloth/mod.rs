@@ -4,6 +4,7 @@
 
 pub mod aggregation;
 pub mod amg;
+pub mod arc_connection;
 pub mod assembly;
 pub mod bcsr;
 pub mod buckling_side;

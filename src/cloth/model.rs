@@ -3,6 +3,7 @@
 
 use std::sync::Arc;
 
+use super::arc_connection::ArcConnection;
 use super::buckling_side::FlexionSide;
 use super::elements::{BendLine, Hinge, ShearQuad, Spring, SpringKind};
 use super::material::{Direction, FabricParameters, MaterialLaw};
@@ -27,6 +28,8 @@ pub struct ClothModel {
     pub bend_lines: Vec<BendLine>,
     /// Dihedral bending hinges.
     pub hinges: Vec<Hinge>,
+    /// Choi–Ko's interlaced connections (empty without Choi–Ko).
+    pub arcs: Vec<ArcConnection>,
     /// The fabric parameters the model was built from.
     pub fabric: FabricParameters,
     /// The material law every element asks.
@@ -122,6 +125,7 @@ impl ClothModel {
             shear_quads,
             bend_lines,
             hinges: Vec::new(),
+            arcs: Vec::new(),
             law: Arc::new(fabric.linear_law()),
             fabric,
             grid: Some((nx, ny)),
@@ -215,6 +219,7 @@ impl ClothModel {
             shear_quads: Vec::new(),
             bend_lines: Vec::new(),
             hinges,
+            arcs: Vec::new(),
             law: Arc::new(fabric.linear_law()),
             fabric,
             grid: None,
@@ -225,7 +230,8 @@ impl ClothModel {
     }
 
     /// Switches to Choi & Ko's buckling model: bending is carried by interlaced connections
-    /// that buckle into arcs when compressed: between
+    /// ([`ArcConnection`], whose arc is as long as the fabric it spans, so a stretched fabric
+    /// is not pushed apart) that buckle into arcs when compressed: between
     /// particles two apart along each grid line (replacing the bending lines) or, on a
     /// triangle mesh, between the opposite vertices of each pair of triangles sharing an edge
     /// (replacing the hinges). Each connection stands for the fabric its element stood for, so
@@ -271,7 +277,7 @@ impl ClothModel {
                     });
                 }
             }
-            self.springs.push(Spring {
+            let spring = Spring {
                 a,
                 b: c,
                 rest: len,
@@ -279,7 +285,9 @@ impl ClothModel {
                 kind: SpringKind::Flexion {
                     warp_weight: if e.dir == Direction::Warp { 1.0 } else { 0.0 },
                 },
-            });
+            };
+            let path0 = dist(a, b).0 + dist(b, c).0;
+            self.arcs.push(ArcConnection::new(spring, [b, b], path0));
         }
         // hinges across seams stay: their wings' rest coordinates lie on different pieces
         let (seams, fabric): (Vec<Hinge>, Vec<Hinge>) = std::mem::take(&mut self.hinges)
@@ -296,13 +304,23 @@ impl ClothModel {
                     across: [e0, e1],
                     rest: len,
                 });
-                self.springs.push(Spring {
+                let spring = Spring {
                     a: c,
                     b: d,
                     rest: len,
                     area: h.area,
                     kind: SpringKind::Flexion { warp_weight },
-                });
+                };
+                // the rest path from c through the shared edge's midpoint to d
+                let mid = [
+                    0.5 * (rest[e0][0] + rest[e1][0]),
+                    0.5 * (rest[e0][1] + rest[e1][1]),
+                ];
+                let leg = |p: usize| {
+                    ((rest[p][0] - mid[0]).powi(2) + (rest[p][1] - mid[1]).powi(2)).sqrt()
+                };
+                self.arcs
+                    .push(ArcConnection::new(spring, [e0, e1], leg(c) + leg(d)));
             }
         }
         self.choi_ko = true;
@@ -369,6 +387,16 @@ impl ClothModel {
                 }
             }
         }
+        for c in &self.arcs {
+            let n = c.nodes;
+            for p in 0..4 {
+                for q in p + 1..4 {
+                    if n[p] != n[q] {
+                        pairs.push((n[p], n[q]));
+                    }
+                }
+            }
+        }
         pairs
     }
 }
@@ -396,12 +424,12 @@ mod tests {
         let pairs = set(&m);
         m.enable_choi_ko();
         assert!(m.bend_lines.is_empty() && m.choi_ko);
-        let flex: Vec<&Spring> = m
-            .springs
-            .iter()
-            .filter(|s| matches!(s.kind, SpringKind::Flexion { .. }))
-            .collect();
+        let flex: Vec<&Spring> = m.arcs.iter().map(|c| &c.spring).collect();
         assert_eq!(flex.len(), lines.len());
+        for (c, e) in m.arcs.iter().zip(&lines) {
+            assert_eq!(c.nodes[2..], [e.nodes[1], e.nodes[1]]);
+            assert!((c.path0 - c.spring.rest).abs() < 1e-15);
+        }
         // the matrix pattern keeps the same couplings (a–c of each line)
         assert_eq!(set(&m), pairs);
         // a flexion connection bent into an arc of curvature κ stores the energy the bending

@@ -131,6 +131,11 @@ pub fn energy_parts(model: &ClothModel, x: &[Vec3]) -> EnergyParts {
             SpringKind::Flexion { .. } => e.flexion += w,
         }
     }
+    for c in &model.arcs {
+        if let Some(ev) = c.eval(law, x) {
+            e.flexion += ev.energy;
+        }
+    }
     for q in &model.shear_quads {
         e.shear += q.area * law.shear(q.measure(x).gamma).2;
     }

@@ -228,7 +228,9 @@ compressed in a perfectly flat cloth bulging to a side drawn from `seed`: the sa
 the same wrinkles bit for bit, another may flip them.",
         |c: &mut ClothHandle, seed: INT| -> RResult<ClothHandle> {
             if seed < 0 {
-                return Err(rt_err(format!("with_choi_ko: seed must be ≥ 0, got {seed}")));
+                return Err(rt_err(format!(
+                    "with_choi_ko: seed must be ≥ 0, got {seed}"
+                )));
             }
             let mut m = (*c.0).clone();
             m.choi_ko_seed = seed as u64;
