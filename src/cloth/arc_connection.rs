@@ -74,14 +74,15 @@ impl ArcConnection {
         }
     }
 
-    /// The virtual length l = |c − a| · min(1, path₀/path), its gradient and the chord part
-    /// of the gradient (see [`ArcEval::chord`]).
-    pub fn virtual_length(&self, x: &[Vec3]) -> (f64, [Vec3; 4], Vec3) {
+    /// The virtual length l = |c − a| · min(1, path₀/path), its gradient, the chord part of
+    /// the gradient (see [`ArcEval::chord`]) and whether the fabric is stretched (path >
+    /// path₀).
+    pub fn virtual_length(&self, x: &[Vec3]) -> (f64, [Vec3; 4], Vec3, bool) {
         let [a, c, m0, m1] = self.nodes;
         let d = x[c] - x[a];
         let chord = d.norm();
         if chord <= 0.0 {
-            return (0.0, [Vec3::zeros(); 4], Vec3::zeros());
+            return (0.0, [Vec3::zeros(); 4], Vec3::zeros(), false);
         }
         let u = d / chord;
         let mid = (x[m0] + x[m1]) * 0.5;
@@ -89,14 +90,19 @@ impl ArcConnection {
         let (l1, l2) = (e1.norm(), e2.norm());
         let path = l1 + l2;
         if path <= self.path0 || l1 <= 0.0 || l2 <= 0.0 {
-            return (chord, [-u, u, Vec3::zeros(), Vec3::zeros()], u);
+            return (chord, [-u, u, Vec3::zeros(), Vec3::zeros()], u, false);
         }
         // l = chord · path₀ / path
         let k = self.path0 / path;
         let q = chord * self.path0 / (path * path);
         let (p1, p2) = (e1 / l1, e2 / l2);
         let gm = (p2 - p1) * (0.5 * q);
-        (chord * k, [-u * k + p1 * q, u * k - p2 * q, gm, gm], u * k)
+        (
+            chord * k,
+            [-u * k + p1 * q, u * k - p2 * q, gm, gm],
+            u * k,
+            true,
+        )
     }
 
     /// Evaluates the connection at `x`; `None` while it is slack (the arc straight). While
@@ -107,12 +113,11 @@ impl ArcConnection {
     /// goes to zero with the bending without the stretch law's stiff onset.
     #[inline]
     pub fn eval(&self, law: &dyn MaterialLaw, x: &[Vec3]) -> Option<ArcEval> {
-        let (len, grad, chord) = self.virtual_length(x);
+        let (len, grad, chord, stretched) = self.virtual_length(x);
         let rest = self.spring.rest;
         if len >= rest {
             return None;
         }
-        let stretched = grad[2] != Vec3::zeros() || grad[3] != Vec3::zeros();
         if !stretched {
             let ev = self
                 .spring
@@ -185,7 +190,7 @@ mod tests {
                 Vec3::new(0.01 * squeeze, 0.001, 0.003),
                 Vec3::new(0.02 * squeeze, 0.0004, -0.001),
             ];
-            let (l, g, _) = c.virtual_length(&x);
+            let (l, g, _, _) = c.virtual_length(&x);
             let h = 1e-8;
             for (node, gn) in [0usize, 2, 1].iter().zip([g[0], g[1], g[2] + g[3]]) {
                 for k in 0..3 {
