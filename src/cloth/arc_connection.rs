@@ -19,8 +19,7 @@
 //! midpoint), which take the reaction: bending, not a push on the membrane.
 
 use super::choi_ko;
-use super::elements::{Spring, SpringKind};
-use super::material::Direction;
+use super::elements::{blend, Spring, SpringKind};
 use super::material::MaterialLaw;
 use crate::geometry::{Mat3, Vec3};
 
@@ -137,13 +136,7 @@ impl ArcConnection {
         };
         let (tension, axial, energy) =
             choi_ko::buckled_connection(self.spring.area, rest, len, |kappa| {
-                let (mu, dmu, wu) = law.bending(Direction::Warp, kappa);
-                if w >= 1.0 {
-                    return (mu, dmu, wu);
-                }
-                let (mv, dmv, wv) = law.bending(Direction::Weft, kappa);
-                let r = 1.0 - w;
-                (w * mu + r * mv, w * dmu + r * dmv, w * wu + r * wv)
+                blend(w, |d| law.bending(d, kappa))
             });
         let [a, c, m0, m1] = self.nodes;
         let mid = (x[m0] + x[m1]) * 0.5;

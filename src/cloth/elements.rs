@@ -141,7 +141,7 @@ impl Spring {
 /// A law's (value, derivative, energy) blended between the warp and the weft:
 /// `w · warp + (1 − w) · weft`, the weft not asked when `w` is 1.
 #[inline]
-fn blend(w: f64, law: impl Fn(Direction) -> (f64, f64, f64)) -> (f64, f64, f64) {
+pub(crate) fn blend(w: f64, law: impl Fn(Direction) -> (f64, f64, f64)) -> (f64, f64, f64) {
     let (fu, dfu, wu) = law(Direction::Warp);
     let ww = 1.0 - w;
     if ww == 0.0 {
