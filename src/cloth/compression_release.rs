@@ -6,7 +6,8 @@
 //! cloth follows by the dynamics. On a grid the three are its line neighbours and the nearer
 //! neighbour across; on a triangle mesh, the spring's other end, the neighbour most nearly
 //! opposite it in the pattern, and the most compressed neighbour roughly across (within 60° of
-//! perpendicular). Of the two intersections, the one clear of
+//! perpendicular), and only when that lowers the compression of its whole ring of springs.
+//! Of the two intersections, the one clear of
 //! the collision bodies (by the contact distance), then the nearer, then the more curved is
 //! chosen; a seeded random draw breaks the remaining ties (a flat cloth buckles up or down at
 //! random, reproducibly for one seed). Particles already in contact are not released.
@@ -281,12 +282,21 @@ impl CompressionRelease {
             }
         }
         let ((o, ro, _), (a, ra, _)) = (opposite?, across?);
-        self.choose(
+        let q = self.choose(
             x[m],
             [x[partner], x[o], x[a]],
             [r_partner, ro, ra],
             obstacles,
-        )
+        )?;
+        // three of its springs released must not compress the others more: the ring's
+        // compression has to drop
+        let ring = &self.adj[self.adj_ptr[m]..self.adj_ptr[m + 1]];
+        let squeeze = |p: &Vec3| -> f64 {
+            ring.iter()
+                .map(|&(k, r)| ((x[k] - p).norm() / r - 1.0).min(0.0).powi(2))
+                .sum()
+        };
+        (squeeze(&q) < squeeze(&x[m])).then_some(q)
     }
 
     /// Of the two points at distances `r` from `c` (the first two along the compression), the
