@@ -54,10 +54,10 @@ impl Level {
         }
     }
 
-    /// Bilinear colour at pixel coordinates `(x, y)` (pixel centres at `i + 0.5`); `None`
-    /// outside the image.
+    /// Bilinear colour at pixel coordinates `(x, y)`, in the cameras' and the rasteriser's
+    /// convention: pixel `(i, j)` is centred on `(i, j)`. `None` outside the image.
     pub fn sample(&self, x: f64, y: f64) -> Option<[f32; 3]> {
-        let (fx, fy) = (x - 0.5, y - 0.5);
+        let (fx, fy) = (x, y);
         if !(fx >= 0.0 && fy >= 0.0) {
             return None;
         }
@@ -171,9 +171,11 @@ mod tests {
         assert_eq!((h.width, h.height), (2, 1));
         assert_eq!(h.rgb[0][0], 5.0);
         assert_eq!(h.rgb[1][0], 25.0);
-        // halfway between pixel centres 0 and 1
-        assert_eq!(l.sample(1.0, 1.0).unwrap()[0], 5.0);
-        assert!(l.sample(3.9, 1.0).is_none());
+        // on pixel centre 1, and halfway between pixel centres 0 and 1
+        assert_eq!(l.sample(1.0, 0.0).unwrap()[0], 10.0);
+        assert_eq!(l.sample(0.5, 0.0).unwrap()[0], 5.0);
+        assert!(l.sample(3.5, 0.0).is_none());
+        assert!(l.sample(-0.1, 0.0).is_none());
     }
 
     #[test]

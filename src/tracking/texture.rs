@@ -56,10 +56,12 @@ pub fn learn_colours(
         let centre = camera.center();
         for v in 0..n {
             let [x, y, z] = projected[v];
-            if !(x >= 0.0 && y >= 0.0) || z <= 0.0 {
+            // the pixel whose centre is nearest (pixel (i, j) is centred on (i, j))
+            let (rx, ry) = (x + 0.5, y + 0.5);
+            if !(rx >= 0.0 && ry >= 0.0) || z <= 0.0 {
                 continue;
             }
-            let (px, py) = (x as usize, y as usize);
+            let (px, py) = (rx as usize, ry as usize);
             if px >= image.width || py >= image.height {
                 continue;
             }
@@ -238,5 +240,37 @@ mod tests {
         // no usable view: nothing seen
         let (_, seen) = learn_colours(&mesh, &skinned, &[(&b, &blue, Some(&hidden))]);
         assert_eq!(seen, 0);
+    }
+
+    #[test]
+    fn a_vertex_learns_the_colour_at_its_projection_regression() {
+        // regression: colours were sampled with pixel centres at i + 0.5 while the cameras
+        // and the rasteriser centre pixel i on i, so every texture was learnt half a pixel up
+        // and left of its vertices; the start, alternating learning and search, walked the
+        // puppet up by about 2 cm (0.5 px per round)
+        let (mesh, skinned) = square();
+        let cam = Camera::looking_at(Vector3::new(0.0, 0.0, 2.0), Vector3::zeros(), 80.0, 64, 64);
+        // a linear ramp: red = 2 × column, green = 2 × row (bilinear sampling is exact)
+        let ramp = Level {
+            width: 64,
+            height: 64,
+            rgb: (0..64 * 64)
+                .map(|i| [2.0 * (i % 64) as f32, 2.0 * (i / 64) as f32, 0.0])
+                .collect(),
+        };
+        let (colours, seen) = learn_colours(&mesh, &skinned, &[(&cam, &ramp, None)]);
+        assert_eq!(seen, 4);
+        let mut projected = Vec::new();
+        project_vertices(&cam, &skinned, &mut projected);
+        for (c, p) in colours.iter().zip(&projected) {
+            assert!(
+                (c[0] - 2.0 * p[0]).abs() < 1e-3 && (c[1] - 2.0 * p[1]).abs() < 1e-3,
+                "vertex at ({}, {}) learnt {c:?}, expected ({}, {})",
+                p[0],
+                p[1],
+                2.0 * p[0],
+                2.0 * p[1]
+            );
+        }
     }
 }
