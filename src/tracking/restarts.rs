@@ -10,11 +10,11 @@ const BENT_KNEE: f64 = -1.2;
 
 /// Alternative starting points of a limb stage searching `dofs` from `current`: the limb as
 /// it was in the previous frame (`previous`, without the velocity prediction, which
-/// overshoots when a limb stops), straight in the rest pose, and half bent (elbow or knee
-/// flexed, the rest as `current`). A limb that fell into a wrong basin (a shin folded behind
-/// an occluder, a forearm hanging where it reaches forward) has no path back through the
-/// small moves around the prediction; the annealing keeps whichever start explains the
-/// images best.
+/// overshoots when a limb stops), straight in the rest pose, half bent and straightened
+/// (elbow or knee flexed, or at zero flexion, the rest as `current`). A limb that fell into a
+/// wrong basin (a shin folded behind an occluder, a forearm hanging where it reaches forward)
+/// has no path back through the small moves around the prediction; the annealing keeps
+/// whichever start explains the images best.
 pub fn limb_restarts(
     infos: &[ParamInfo],
     current: &[f64],
@@ -24,18 +24,24 @@ pub fn limb_restarts(
 ) {
     out.push(previous.to_vec());
     out.push(vec![0.0; current.len()]);
-    let mut bent = current.to_vec();
-    for &k in dofs {
-        let name = &infos[k].name;
-        if name.ends_with(".flex") {
-            if name.starts_with("lowerarm01") {
-                bent[k] = BENT_ELBOW.clamp(infos[k].lo, infos[k].hi);
-            } else if name.starts_with("lowerleg01") {
-                bent[k] = BENT_KNEE.clamp(infos[k].lo, infos[k].hi);
+    for straight in [false, true] {
+        let mut limb = current.to_vec();
+        for &k in dofs {
+            let name = &infos[k].name;
+            if name.ends_with(".flex") {
+                let bent = if name.starts_with("lowerarm01") {
+                    BENT_ELBOW
+                } else if name.starts_with("lowerleg01") {
+                    BENT_KNEE
+                } else {
+                    continue;
+                };
+                let flex = if straight { 0.0 } else { bent };
+                limb[k] = flex.clamp(infos[k].lo, infos[k].hi);
             }
         }
+        out.push(limb);
     }
-    out.push(bent);
 }
 
 #[cfg(test)]
@@ -53,7 +59,7 @@ mod tests {
     }
 
     #[test]
-    fn limb_restarts_are_the_previous_the_rest_and_the_half_bent_limb() {
+    fn limb_restarts_are_the_previous_the_rest_the_half_bent_and_the_straightened_limb() {
         let infos = [
             info("upperleg01.L.flex", -0.7, 2.27),
             info("lowerleg01.L.flex", -2.79, 0.21),
@@ -65,12 +71,14 @@ mod tests {
         let mut out = Vec::new();
         // a leg stage: the knee bends, the elbow (not searched) keeps its value
         limb_restarts(&infos, &current, &[0, 1, 2], &previous, &mut out);
-        assert_eq!(out.len(), 3);
+        assert_eq!(out.len(), 4);
         assert_eq!(out[0], previous);
         assert_eq!(out[1], vec![0.0; 4]);
         assert_eq!(out[2], vec![0.4, BENT_KNEE, 0.2, 0.3]);
+        assert_eq!(out[3], vec![0.4, 0.0, 0.2, 0.3]);
         out.clear();
         limb_restarts(&infos, &current, &[3], &previous, &mut out);
         assert_eq!(out[2], vec![0.4, -0.1, 0.2, BENT_ELBOW]);
+        assert_eq!(out[3], vec![0.4, -0.1, 0.2, 0.0]);
     }
 }
