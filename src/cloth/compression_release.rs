@@ -5,7 +5,7 @@
 //! there for a few steps through the solver's constraint filter (S, z), so the rest of the
 //! cloth follows by the dynamics. On a grid the three are its line neighbours and the nearer
 //! neighbour across; on a triangle mesh, the spring's other end, the neighbour most nearly
-//! opposite it in the pattern, and the most compressed neighbour roughly across (within 60° of
+//! opposite it in the pattern, and the most compressed neighbour roughly across (within 30° of
 //! perpendicular), and only when that lowers the compression of its whole ring of springs.
 //! Of the two intersections, the one clear of
 //! the collision bodies (by the contact distance), then the nearer, then the more curved is
@@ -242,7 +242,7 @@ impl CompressionRelease {
 
     /// On a triangle mesh, the destination that releases particle `m`'s spring to `partner`:
     /// three spheres around the partner, the neighbour most nearly opposite it in the pattern
-    /// (at least 120° away) and the most compressed neighbour within 60° of perpendicular;
+    /// (at least 120° away) and the most compressed neighbour within 30° of perpendicular;
     /// `None` at a border without such neighbours.
     fn mesh_destination(
         &mut self,
