@@ -152,7 +152,7 @@ of each annealing layer, coarse first, e.g. [1, 1, 1, 0, 0]), `robust_sigma` (gr
 `mesh_cell` (metres), `lbs` (linear blend skinning instead of rigid), `background_frames`,
 `prediction` (velocity factor), `prior_weight` (motion prior per squared move spread,
 default 0.05), `limb_restarts` (limb stages also start from the previous,
-the rest and a half-bent limb pose; default true), `seed`, `frames` (track only the first
+the rest, a half-bent and a straightened limb pose; default true), `seed`, `frames` (track only the first
 frames), `passes` (spread factor of each pass of the stage hierarchy per frame, e.g. [1.0, 0.35]),
 `overlay_every` (0: no pictures), `makehuman` (folder of the body model).",
         |seq: &str, out: &str, m: Map| track(seq, out, &m)

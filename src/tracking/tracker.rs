@@ -72,7 +72,8 @@ pub struct TrackerOptions {
     /// Weight of the motion prior (per squared move spread of a parameter).
     pub prior_weight: f64,
     /// Limb stages also start particles from the previous frame's limb pose (no
-    /// prediction), the rest pose and a half-bent pose (see [`limb_restarts`](super::restarts::limb_restarts)).
+    /// prediction), the rest pose, and the predicted limb half bent or straightened (see
+    /// [`limb_restarts`](super::restarts::limb_restarts)).
     pub limb_restarts: bool,
 }
 
