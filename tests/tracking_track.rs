@@ -79,6 +79,15 @@ fn frame_errors(frames: &Frames) -> Vec<f64> {
         .collect()
 }
 
+/// Error of joint `name` in each frame (mm).
+fn joint_errors(frames: &Frames, name: &str) -> Vec<f64> {
+    let k = emilion::tracking::joints::joint_index(name).unwrap();
+    frames
+        .iter()
+        .map(|(j, t)| 1000.0 * (j[k] - t[k]).norm())
+        .collect()
+}
+
 #[test]
 fn punch_is_tracked_without_losing_it() {
     let dir = temp("punch");
@@ -121,11 +130,7 @@ fn running_shin_folded_behind_the_occluder_comes_back() {
         &[("overlay_every", "0"), ("frames", "24")],
     );
     assert_eq!(frames.len(), 24);
-    let l_ankle = emilion::tracking::joints::joint_index("l_ankle").unwrap();
-    let ankle: Vec<f64> = frames
-        .iter()
-        .map(|(j, t)| 1000.0 * (j[l_ankle] - t[l_ankle]).norm())
-        .collect();
+    let ankle = joint_errors(&frames, "l_ankle");
     let errors = frame_errors(&frames);
     let mean = errors.iter().sum::<f64>() / errors.len() as f64;
     println!("left ankle errors (mm): {ankle:.0?}; MPJPE {mean:.1} mm");
@@ -153,11 +158,7 @@ fn running_shin_stays_folded_when_the_leg_reaches_forward_regression() {
         &[("overlay_every", "0"), ("frames", "32"), ("seed", "2")],
     );
     assert_eq!(frames.len(), 32);
-    let l_ankle = emilion::tracking::joints::joint_index("l_ankle").unwrap();
-    let ankle: Vec<f64> = frames
-        .iter()
-        .map(|(j, t)| 1000.0 * (j[l_ankle] - t[l_ankle]).norm())
-        .collect();
+    let ankle = joint_errors(&frames, "l_ankle");
     println!("left ankle errors (mm): {ankle:.0?}");
     let ankle_mean = ankle.iter().sum::<f64>() / ankle.len() as f64;
     assert!(
