@@ -470,12 +470,7 @@ impl Assembly {
                             None
                         };
                         let Some((theta, grad)) = angle else {
-                            for m in 0..4 {
-                                g[4 * k + m] = Vec3::zeros();
-                                for q in 0..4 {
-                                    bl[16 * k + 4 * m + q] = Mat3::zeros();
-                                }
-                            }
+                            clear_four_node_element(g, bl, k);
                             continue;
                         };
                         let kappa = theta.abs() * el.edge / el.area;
@@ -537,12 +532,7 @@ impl Assembly {
                     for k in 0..els.len() {
                         let el = &els[k];
                         let Some(ev) = el.eval(law, x) else {
-                            for m in 0..4 {
-                                g[4 * k + m] = Vec3::zeros();
-                                for q in 0..4 {
-                                    bl[16 * k + 4 * m + q] = Mat3::zeros();
-                                }
-                            }
+                            clear_four_node_element(g, bl, k);
                             continue;
                         };
                         e += ev.energy;
@@ -735,6 +725,13 @@ impl Assembly {
 
 /// Inverse of a diagonal block, or a scaled identity if it is singular.
 #[inline]
+/// Zeroes the force terms and the 4 × 4 stiffness blocks of four-node element `k` of a chunk
+/// (a hinge or an arc that contributes nothing this step).
+fn clear_four_node_element(g: &mut [Vec3], blocks: &mut [Mat3], k: usize) {
+    g[4 * k..4 * k + 4].fill(Vec3::zeros());
+    blocks[16 * k..16 * k + 16].fill(Mat3::zeros());
+}
+
 fn block_inverse(d: &Mat3) -> Mat3 {
     d.try_inverse()
         .unwrap_or_else(|| Mat3::identity() / d.trace().max(1e-300))
