@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use super::arc_connection::ArcConnection;
-use super::buckling_side::FlexionSide;
+use super::buckling_side::{turns_left, FlexionSide};
 use super::elements::{BendLine, Hinge, ShearQuad, Spring, SpringKind};
 use super::material::{Direction, FabricParameters, MaterialLaw};
 use super::ClothError;
@@ -274,6 +274,7 @@ impl ClothModel {
                         middle: [b, b],
                         across: [b, o],
                         rest: len,
+                        front: turns_left(rest, [a, c], [b, o]),
                     });
                 }
             }
@@ -303,6 +304,7 @@ impl ClothModel {
                     middle: [e0, e1],
                     across: [e0, e1],
                     rest: len,
+                    front: turns_left(rest, [c, d], [e0, e1]),
                 });
                 let spring = Spring {
                     a: c,

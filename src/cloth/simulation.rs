@@ -390,9 +390,15 @@ impl Simulation {
         }
         if let Some(sides) = &mut self.sides {
             let attachments = &self.attachments;
-            sides.start_arcs(&mut self.state.x, |i| {
-                attachments.iter().any(|a| a.particles.contains(&i))
-            });
+            let obstacles = Obstacles {
+                bodies: &self.contact.bodies,
+                clearance: self.contact.settings.thickness,
+            };
+            sides.start_arcs(
+                &mut self.state.x,
+                |i| attachments.iter().any(|a| a.particles.contains(&i)),
+                |p| obstacles.is_clear(p),
+            );
         }
         self.x_save.copy_from_slice(&self.state.x);
         self.v_save.copy_from_slice(&self.state.v);
