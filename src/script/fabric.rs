@@ -211,8 +211,8 @@ pub fn register(engine: &mut Engine) {
         "A copy of the cloth with Choi & Ko's buckling model: bending is carried by interlaced
 connections (two apart along grid lines, or across each pair of triangles) that buckle into
 arcs when compressed, pushing their ends apart with the arc's force; stretch springs keep the
-measured law. A connection compressed in a perfectly flat cloth bulges to a side drawn from
-seed 1 (see `with_choi_ko(seed)`).",
+measured law. Connections compressed in a perfectly flat cloth bulge away from a collision
+body, else all to one side of the cloth drawn (per step) from seed 1 (see `with_choi_ko(seed)`).",
         |c: &mut ClothHandle| -> RResult<ClothHandle> {
             let mut m = (*c.0).clone();
             m.enable_choi_ko();
@@ -224,7 +224,7 @@ seed 1 (see `with_choi_ko(seed)`).",
         "with_choi_ko",
         ["cloth: Cloth", "seed: int", "Cloth"],
         "A copy of the cloth with Choi & Ko's buckling model (see `with_choi_ko()`), a connection
-compressed in a perfectly flat cloth bulging to a side drawn from `seed`: the same seed gives
+compressed in a perfectly flat cloth bulging to the side of the cloth drawn from `seed`: the same seed gives
 the same wrinkles bit for bit, another may flip them.",
         |c: &mut ClothHandle, seed: INT| -> RResult<ClothHandle> {
             if seed < 0 {

@@ -270,7 +270,7 @@ pub fn register(engine: &mut Engine) {
 most compressed springs' particles are sent to where their springs regain their rest length
 (three spheres' intersection) and held there. `#{strain: 0.01, hold_steps: 3, seed: 1}`: the
 compression that triggers a release, how long a particle is held, the seed of the random
-up/down choice on a flat cloth.",
+up/down choice on a flat cloth (one side of the cloth per step for all its ties).",
         |h: &mut SimHandle, m: Map| -> RResult<()> {
             use crate::cloth::compression_release::{CompressionRelease, ReleaseOptions};
             const KEYS: [&str; 3] = ["strain", "hold_steps", "seed"];
