@@ -363,6 +363,14 @@ fn cloth_pushed_along_a_cylinder_is_released_by_compression_release() {
         field(rel, "elastic") < field(none, "elastic"),
         "{none}\n{rel}"
     );
+    // regression: and over the resting frames. A particle well off its neighbours' plane
+    // whose near destination lay in the cylinder jumped to the far one, through the cloth
+    // (up to 1.36 rest lengths), and kicked it at rest: the resting mean was 0.0177 J against
+    // 0.0155 J without a model, and the state after the last step held 0.046 J on one seed
+    assert!(
+        field(rel, "resting mean") < field(none, "resting mean"),
+        "{none}\n{rel}"
+    );
     assert!(dir.join("energy.png").exists() && dir.join("release_24.png").exists());
 }
 
