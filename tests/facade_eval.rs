@@ -124,9 +124,10 @@ fn eval_script_prints_the_summary_line_and_writes_its_tables() {
             .unwrap_or(f64::NAN)
     };
     assert_eq!(field("images="), 11.0, "{last}");
-    // it finds windows where the all-wall baseline finds none (the figures are far below the
-    // issue's goal: see the README)
-    assert!(field("window_iou=") > 0.05 && field("f1=") > 0.0, "{last}");
+    // well above labelling every pixel window (0.095 window IoU on these photos) and above the
+    // floors × tiles lattice alone (0.083, F1 0.05), which the windows found one by one
+    // replaced; still far below the goal (see the README)
+    assert!(field("window_iou=") > 0.2 && field("f1=") > 0.15, "{last}");
     // an unknown method is a script error at its line
     let bad = run(&["method=mueller"]);
     assert!(!bad.status.success());

@@ -30,6 +30,8 @@ pub mod score;
 pub mod segments;
 pub mod structure;
 pub mod vanishing;
+pub mod window_blobs;
+pub mod window_grammar;
 
 pub use error::FacadeError;
 pub use labels::{Class, LabelMap};

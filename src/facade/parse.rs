@@ -13,6 +13,8 @@ use super::parse_grammar::grammar_of;
 use super::rect::Rect;
 use super::repetition::{detect, Axis};
 use super::report::FacadeParse;
+use super::window_blobs::{detect_windows, BlobParams};
+use super::window_grammar::grammar_of_windows;
 
 /// Priors of the parse, as fractions of the image's extent.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -65,6 +67,12 @@ pub struct Structure {
     pub strength: (f64, f64),
     /// The irreducible tile (mean of the repeated tiles), row-major, `tile × floor`.
     pub irreducible: Vec<f64>,
+    /// The windows found one by one ([`super::window_blobs`]), photo pixels.
+    pub windows: Vec<Rect>,
+    /// Whether the grammar is that of `windows` ([`super::window_grammar`]): when the
+    /// layout's windows agree with them less than [`GRID_AGREEMENT`]; otherwise the grammar
+    /// is the layout's (floors and tiles that repeat).
+    pub from_windows: bool,
     /// Seconds spent in: floor search, tile search, irreducible tile, window.
     pub seconds: [f64; 4],
 }
@@ -167,6 +175,7 @@ pub fn parse_region(
         window = tile_window(&tile, tw, fh, priors.window);
     }
     let (row_starts, col_starts) = synchronise(img, &rows, &cols, &mut present, &window, fh, tw);
+    let windows = detect_windows(full, &region, &BlobParams::default());
     let t4 = Instant::now();
     let off = |v: &[u32], o: u32| v.iter().map(|&x| x + o).collect::<Vec<u32>>();
     let offf = |v: Vec<f64>, o: u32| v.into_iter().map(|x| x + o as f64).collect::<Vec<f64>>();
@@ -183,6 +192,8 @@ pub fn parse_region(
         present,
         strength: (floors.strength, tiles.strength),
         irreducible: tile,
+        windows,
+        from_windows: false,
         seconds: [
             (t1 - t0).as_secs_f64(),
             (t2 - t1).as_secs_f64(),
@@ -190,7 +201,43 @@ pub fn parse_region(
             (t4 - t3).as_secs_f64(),
         ],
     };
-    Ok((grammar_of(&structure, full.width, full.height), structure))
+    let mut structure = structure;
+    let grid = grammar_of(&structure, full.width, full.height);
+    if structure.windows.is_empty()
+        || window_agreement(&grid, &structure.windows, full.width, full.height) >= GRID_AGREEMENT
+    {
+        return Ok((grid, structure));
+    }
+    structure.from_windows = true;
+    let grammar = grammar_of_windows(&structure.windows, full.width, full.height);
+    Ok((grammar, structure))
+}
+
+/// Least agreement (IoU of the window pixels) of the layout's windows with the windows found
+/// one by one for the grammar to be the layout's.
+pub const GRID_AGREEMENT: f64 = 0.6;
+
+/// IoU of the window pixels of `g` derived at `width` × `height` and of `windows`.
+fn window_agreement(g: &Grammar, windows: &[Rect], width: u32, height: u32) -> f64 {
+    let Ok(leaves) = g.derive(width as f64, height as f64) else {
+        return 0.0;
+    };
+    let grid = rasterize(&leaves, width, height).labels;
+    let mut found = LabelMap::filled(width, height, Class::Wall);
+    for r in windows {
+        found.paint(r, Class::Window);
+    }
+    let (mut both, mut either) = (0u64, 0u64);
+    for (a, b) in grid.classes.iter().zip(&found.classes) {
+        let (a, b) = (*a == Class::Window, *b == Class::Window);
+        both += (a && b) as u64;
+        either += (a || b) as u64;
+    }
+    if either == 0 {
+        0.0
+    } else {
+        both as f64 / either as f64
+    }
 }
 
 /// Least difference (grey levels) between a window and its wall for a cell to keep its window.

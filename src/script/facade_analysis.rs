@@ -148,8 +148,9 @@ when it failed), and total.",
         engine,
         "structure",
         ["a: FacadeAnalysis", "Map"],
-        "The parse: #{floor, tile (pixels), floors, tiles (cells of the layout), windows (cells
-holding a window), rules (the rule file)}; empty when the parse failed.",
+        "The parse: #{floor, tile (pixels), floors, tiles (cells of the layout), windows (the windows
+of the grammar: those found one by one, or the layout's cells holding a window), rules (the
+rule file)}; empty when the parse failed.",
         |a: &mut FacadeAnalysis| {
             let mut m = Map::new();
             if let Ok((g, s)) = &a.0.parse {
@@ -158,7 +159,14 @@ holding a window), rules (the rule file)}; empty when the parse failed.",
                     ("tile", s.tile as INT),
                     ("floors", s.count.0 as INT),
                     ("tiles", s.count.1 as INT),
-                    ("windows", s.present.iter().filter(|&&p| p).count() as INT),
+                    (
+                        "windows",
+                        if !s.from_windows {
+                            s.present.iter().filter(|&&p| p).count()
+                        } else {
+                            s.windows.len()
+                        } as INT,
+                    ),
                 ] {
                     m.insert(k.into(), Dynamic::from_int(v));
                 }

@@ -1,0 +1,239 @@
+//! Windows found as dark blobs of the rectified facade: a pixel belongs to a window candidate
+//! when it is darker than its neighbourhood (glass shows the unlit inside), candidates are the
+//! connected pieces of such pixels whose bounding box has a window's size, shape and fill,
+//! and a candidate is kept only when another one of about its size stands in its row or its
+//! column (windows repeat: Müller et al.'s prior, without asking for one global lattice, which
+//! street photos of several buildings break). The parameters were chosen on the tuning half of
+//! the labelled photos (`scripts/facades_eval.rhai --set half=tune`).
+
+use super::gray::Gray;
+use super::rect::Rect;
+
+/// Parameters of the detector (fractions are of the facade region).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BlobParams {
+    /// Half-width of the neighbourhood a pixel is compared with, as a share of the region's
+    /// larger side.
+    pub scale: f64,
+    /// How many of the neighbourhood's standard deviations below its mean a window pixel lies.
+    pub contrast: f64,
+    /// Least share of its bounding box a candidate fills.
+    pub fill: f64,
+    /// Smallest and largest bounding box, as shares of the region's area.
+    pub area: (f64, f64),
+    /// Least and greatest height / width of the bounding box.
+    pub aspect: (f64, f64),
+    /// Least overlap (share of the smaller extent) of two candidates in one row or column.
+    pub align: f64,
+    /// Greatest relative difference of height and of width of two candidates that support
+    /// each other.
+    pub similar: f64,
+}
+
+impl Default for BlobParams {
+    fn default() -> Self {
+        BlobParams {
+            scale: 0.08,
+            contrast: 0.6,
+            fill: 0.3,
+            area: (0.0005, 0.03),
+            aspect: (0.25, 4.0),
+            align: 0.3,
+            similar: 0.5,
+        }
+    }
+}
+
+/// Sums of `v` over `[0, x) × [0, y)`, `(w + 1) × (h + 1)`, row-major.
+fn integral(v: impl Iterator<Item = f64>, w: usize, h: usize) -> Vec<f64> {
+    let mut s = vec![0.0; (w + 1) * (h + 1)];
+    let mut v = v;
+    for y in 0..h {
+        let mut row = 0.0;
+        for x in 0..w {
+            row += v.next().unwrap_or(0.0);
+            s[(y + 1) * (w + 1) + x + 1] = s[y * (w + 1) + x + 1] + row;
+        }
+    }
+    s
+}
+
+/// The pixels darker than their neighbourhood's mean by `contrast` standard deviations (at
+/// least one grey level), inside `region` only; row-major over the whole image.
+pub fn dark_pixels(img: &Gray, region: &Rect, p: &BlobParams) -> Vec<bool> {
+    let (w, h) = (img.width as usize, img.height as usize);
+    let side = (region.x1 - region.x0).max(region.y1 - region.y0) as f64;
+    let r = ((p.scale * side) as usize).max(3);
+    let g = |i: usize| img.data[i] as f64;
+    let s1 = integral((0..w * h).map(g), w, h);
+    let s2 = integral((0..w * h).map(|i| g(i) * g(i)), w, h);
+    let mut dark = vec![false; w * h];
+    for y in region.y0 as usize..region.y1 as usize {
+        let (ya, yb) = (y.saturating_sub(r), (y + r + 1).min(h));
+        for x in region.x0 as usize..region.x1 as usize {
+            let (xa, xb) = (x.saturating_sub(r), (x + r + 1).min(w));
+            let sum = |s: &[f64]| {
+                s[yb * (w + 1) + xb] - s[ya * (w + 1) + xb] - s[yb * (w + 1) + xa]
+                    + s[ya * (w + 1) + xa]
+            };
+            let n = ((yb - ya) * (xb - xa)) as f64;
+            let mean = sum(&s1) / n;
+            let sd = (sum(&s2) / n - mean * mean).max(1.0).sqrt();
+            dark[y * w + x] = g(y * w + x) < mean - p.contrast * sd;
+        }
+    }
+    dark
+}
+
+/// Connected pieces (4-neighbours) of the set pixels: bounding box and pixel count of each,
+/// in the order of their first pixel (row-major).
+pub fn pieces(mask: &[bool], w: usize, h: usize) -> Vec<(Rect, u64)> {
+    let mut seen = vec![false; mask.len()];
+    let mut stack = Vec::new();
+    let mut out = Vec::new();
+    for start in 0..mask.len() {
+        if !mask[start] || seen[start] {
+            continue;
+        }
+        seen[start] = true;
+        stack.push(start);
+        let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
+        let mut n = 0u64;
+        while let Some(i) = stack.pop() {
+            let (x, y) = (i % w, i / w);
+            n += 1;
+            x0 = x0.min(x);
+            y0 = y0.min(y);
+            x1 = x1.max(x + 1);
+            y1 = y1.max(y + 1);
+            let mut visit = |j: usize| {
+                if mask[j] && !seen[j] {
+                    seen[j] = true;
+                    stack.push(j);
+                }
+            };
+            if x > 0 {
+                visit(i - 1);
+            }
+            if x + 1 < w {
+                visit(i + 1);
+            }
+            if y > 0 {
+                visit(i - w);
+            }
+            if y + 1 < h {
+                visit(i + w);
+            }
+        }
+        let r = Rect {
+            x0: x0 as u32,
+            y0: y0 as u32,
+            x1: x1 as u32,
+            y1: y1 as u32,
+        };
+        out.push((r, n));
+    }
+    out
+}
+
+/// Whether two candidates support each other: about the same size, in one row or column.
+fn supports(a: &Rect, b: &Rect, p: &BlobParams) -> bool {
+    let (ha, hb) = ((a.y1 - a.y0) as f64, (b.y1 - b.y0) as f64);
+    let (wa, wb) = ((a.x1 - a.x0) as f64, (b.x1 - b.x0) as f64);
+    let like =
+        (ha - hb).abs() <= p.similar * ha.max(hb) && (wa - wb).abs() <= p.similar * wa.max(wb);
+    let rows = a.y1.min(b.y1) as f64 - a.y0.max(b.y0) as f64;
+    let cols = a.x1.min(b.x1) as f64 - a.x0.max(b.x0) as f64;
+    like && (rows > p.align * ha.min(hb) || cols > p.align * wa.min(wb))
+}
+
+/// The windows of the facade in `region` of the rectified photo (photo pixels), in the order
+/// of their top-left pixel.
+pub fn detect_windows(img: &Gray, region: &Rect, p: &BlobParams) -> Vec<Rect> {
+    if region.area() == 0 {
+        return Vec::new();
+    }
+    let dark = dark_pixels(img, region, p);
+    let area = region.area() as f64;
+    let candidates: Vec<Rect> = pieces(&dark, img.width as usize, img.height as usize)
+        .into_iter()
+        .filter(|(r, n)| {
+            let a = r.area() as f64;
+            let aspect = (r.y1 - r.y0) as f64 / (r.x1 - r.x0) as f64;
+            a >= p.area.0 * area
+                && a <= p.area.1 * area
+                && *n as f64 >= p.fill * a
+                && aspect >= p.aspect.0
+                && aspect <= p.aspect.1
+        })
+        .map(|(r, _)| r)
+        .collect();
+    candidates
+        .iter()
+        .enumerate()
+        .filter(|&(i, a)| {
+            candidates
+                .iter()
+                .enumerate()
+                .any(|(j, b)| j != i && supports(a, b, p))
+        })
+        .map(|(_, r)| *r)
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A light wall with dark windows at `windows`.
+    fn facade(w: u32, h: u32, windows: &[Rect]) -> Gray {
+        let mut data = vec![200u8; (w * h) as usize];
+        for r in windows {
+            for y in r.y0..r.y1 {
+                for x in r.x0..r.x1 {
+                    data[(y * w + x) as usize] = 40;
+                }
+            }
+        }
+        Gray {
+            width: w,
+            height: h,
+            data,
+        }
+    }
+
+    fn rect(x0: u32, y0: u32, x1: u32, y1: u32) -> Rect {
+        Rect { x0, y0, x1, y1 }
+    }
+
+    #[test]
+    fn a_grid_of_dark_windows_is_found_exactly() {
+        let windows: Vec<Rect> = (0..3)
+            .flat_map(|i| {
+                (0..4).map(move |j| rect(20 + 50 * j, 30 + 60 * i, 45 + 50 * j, 65 + 60 * i))
+            })
+            .collect();
+        let img = facade(220, 200, &windows);
+        let region = rect(0, 0, 220, 200);
+        let found = detect_windows(&img, &region, &BlobParams::default());
+        assert_eq!(found, windows);
+    }
+
+    #[test]
+    fn a_lone_dark_patch_is_no_window() {
+        // one window-sized patch with nothing like it in its row or column
+        let img = facade(200, 200, &[rect(80, 80, 105, 115)]);
+        let found = detect_windows(&img, &rect(0, 0, 200, 200), &BlobParams::default());
+        assert!(found.is_empty(), "{found:?}");
+    }
+
+    #[test]
+    fn pieces_are_four_connected() {
+        // two pixels touching at a corner are two pieces
+        let mask = [true, false, false, true];
+        let p = pieces(&mask, 2, 2);
+        assert_eq!(p.len(), 2);
+        assert_eq!(p[0], (rect(0, 0, 1, 1), 1));
+        assert_eq!(p[1], (rect(1, 1, 2, 2), 1));
+    }
+}

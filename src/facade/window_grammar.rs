@@ -1,0 +1,243 @@
+//! The grammar of a facade whose windows were found one by one
+//! ([`super::window_blobs`]), by recursive XY cuts: the facade is split top to bottom into
+//! wall and the rows of windows (groups that overlap vertically), each row left to right into
+//! wall and columns, and so on until a part is one window or wall. Windows keep their size
+//! (fixed parts), the wall between them floats, so the rules regenerate the parse exactly at
+//! the photo's size and spread or squeeze the windows at other sizes. Identical parts share
+//! one rule.
+
+use std::collections::BTreeMap;
+
+use super::grammar::{Body, Dir, Grammar, Size};
+use super::labels::Class;
+use super::rect::Rect;
+
+/// The extent of `r` along `dir`.
+fn span(r: &Rect, dir: Dir) -> (u32, u32) {
+    match dir {
+        Dir::X => (r.x0, r.x1),
+        Dir::Y => (r.y0, r.y1),
+    }
+}
+
+/// The windows grouped by their projection on `dir`: groups whose extents do not overlap, in
+/// order, each with its extent.
+fn groups(windows: &[Rect], dir: Dir) -> Vec<((u32, u32), Vec<Rect>)> {
+    let mut sorted = windows.to_vec();
+    sorted.sort_by_key(|r| (span(r, dir), r.x0, r.y0, r.x1, r.y1));
+    let mut out: Vec<((u32, u32), Vec<Rect>)> = Vec::new();
+    for r in sorted {
+        let (a, b) = span(&r, dir);
+        match out.last_mut() {
+            Some(((_, end), members)) if a < *end => {
+                *end = (*end).max(b);
+                members.push(r);
+            }
+            _ => out.push(((a, b), vec![r])),
+        }
+    }
+    out
+}
+
+/// The name of `body` among the rules made so far (`base1`, `base2`, … by first use), adding
+/// it when new.
+fn named(rules: &mut BTreeMap<String, Body>, body: Body, base: &str) -> String {
+    if let Some((n, _)) = rules
+        .iter()
+        .find(|(n, b)| **b == body && n.starts_with(base))
+    {
+        return n.clone();
+    }
+    let k = rules.keys().filter(|n| n.starts_with(base)).count() + 1;
+    let n = format!("{base}{k}");
+    rules.insert(n.clone(), body);
+    n
+}
+
+/// A split along `dir` of `[a, b)` into floating wall and fixed parts at `items` (start, end,
+/// rule), zero-length walls left out.
+fn split_between(dir: Dir, a: u32, b: u32, items: &[(u32, u32, String)]) -> Body {
+    let mut parts = Vec::new();
+    let mut at = a;
+    for (s, e, rule) in items {
+        if *s > at {
+            parts.push((Size::Floating((s - at) as f64), "Wall".to_string()));
+        }
+        parts.push((Size::Fixed((e - s) as f64), rule.clone()));
+        at = *e;
+    }
+    if b > at {
+        parts.push((Size::Floating((b - at) as f64), "Wall".to_string()));
+    }
+    Body::Split { dir, parts }
+}
+
+/// The rule for `scope` holding `windows` (each inside it): wall, the window filling it, or
+/// a cut across the scope between windows: rows first, then columns (recursive XY cut). When
+/// no cut separates them (windows that overlap, or four that wind round each other), the
+/// smallest is dropped.
+fn rule_of(rules: &mut BTreeMap<String, Body>, scope: Rect, windows: &[Rect]) -> String {
+    match windows {
+        [] => return "Wall".into(),
+        [w] if *w == scope => return "Window".into(),
+        _ => {}
+    }
+    for (dir, base) in [(Dir::Y, "Rows"), (Dir::X, "Columns")] {
+        let g = groups(windows, dir);
+        let (a, b) = span(&scope, dir);
+        if g.len() == 1 && g[0].0 == (a, b) {
+            continue;
+        }
+        let items: Vec<(u32, u32, String)> = g
+            .into_iter()
+            .map(|((s, e), members)| {
+                let sub = match dir {
+                    Dir::Y => Rect {
+                        y0: s,
+                        y1: e,
+                        ..scope
+                    },
+                    Dir::X => Rect {
+                        x0: s,
+                        x1: e,
+                        ..scope
+                    },
+                };
+                (s, e, rule_of(rules, sub, &members))
+            })
+            .collect();
+        let body = split_between(dir, a, b, &items);
+        return named(rules, body, base);
+    }
+    let smallest = (0..windows.len())
+        .min_by_key(|&i| (windows[i].area(), i))
+        .unwrap_or(0);
+    let rest: Vec<Rect> = windows
+        .iter()
+        .enumerate()
+        .filter(|&(i, _)| i != smallest)
+        .map(|(_, r)| *r)
+        .collect();
+    rule_of(rules, scope, &rest)
+}
+
+/// The grammar of a `width` × `height` facade with `windows` (photo pixels, clipped to it)
+/// and wall elsewhere.
+pub fn grammar_of_windows(windows: &[Rect], width: u32, height: u32) -> Grammar {
+    let mut rules = BTreeMap::new();
+    rules.insert("Wall".to_string(), Body::Leaf(Class::Wall));
+    rules.insert("Window".to_string(), Body::Leaf(Class::Window));
+    let inside: Vec<Rect> = windows
+        .iter()
+        .map(|r| Rect {
+            x0: r.x0.min(width),
+            y0: r.y0.min(height),
+            x1: r.x1.min(width),
+            y1: r.y1.min(height),
+        })
+        .filter(|r| r.area() > 0)
+        .collect();
+    let full = Rect {
+        x0: 0,
+        y0: 0,
+        x1: width,
+        y1: height,
+    };
+    let top = rule_of(&mut rules, full, &inside);
+    let facade = rules.get(&top).cloned().unwrap_or(Body::Leaf(Class::Wall));
+    rules.insert("Facade".to_string(), facade);
+    let used_elsewhere = rules.values().any(|b| match b {
+        Body::Split { parts, .. } => parts.iter().any(|(_, r)| *r == top),
+        Body::Repeat { rule, .. } => *rule == top,
+        Body::Leaf(_) => false,
+    });
+    if top != "Wall" && top != "Window" && !used_elsewhere {
+        rules.remove(&top);
+    }
+    Grammar {
+        rules,
+        axiom: "Facade".into(),
+        size: (width as f64, height as f64),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::facade::parse::{rasterize, round_trip};
+
+    fn rect(x0: u32, y0: u32, x1: u32, y1: u32) -> Rect {
+        Rect { x0, y0, x1, y1 }
+    }
+
+    #[test]
+    fn the_rules_paint_the_windows_back_exactly() {
+        // staggered rows and columns (no one band holds a whole row), and one window inside
+        // another's extent that no cut can separate: it is dropped
+        let windows = [
+            rect(10, 20, 30, 50),
+            rect(40, 25, 60, 50),
+            rect(70, 20, 90, 50),
+            rect(55, 30, 65, 45),
+            rect(10, 45, 30, 110),
+            rect(40, 60, 60, 90),
+            rect(70, 80, 90, 110),
+        ];
+        let g = grammar_of_windows(&windows, 100, 120);
+        let leaves = g.derive(100.0, 120.0).expect("derives");
+        let parse = rasterize(&leaves, 100, 120);
+        let mut got = parse.windows.clone();
+        got.sort_by_key(|r| (r.y0, r.x0));
+        let mut want: Vec<Rect> = windows
+            .iter()
+            .copied()
+            .filter(|r| *r != rect(55, 30, 65, 45))
+            .collect();
+        want.sort_by_key(|r| (r.y0, r.x0));
+        // the window at 10..30 × 20..50 and the one below it overlap in rows 45..50: the
+        // smaller of the two goes
+        want.retain(|r| *r != rect(10, 20, 30, 50));
+        assert_eq!(got, want);
+        assert_eq!(round_trip(&g, 100, 120).expect("round trip"), 1.0);
+    }
+
+    #[test]
+    fn repeated_windows_share_their_rule() {
+        let windows: Vec<Rect> = (0..3)
+            .flat_map(|i| {
+                (0..3).map(move |j| rect(10 + 30 * j, 10 + 40 * i, 30 + 30 * j, 40 + 40 * i))
+            })
+            .collect();
+        let g = grammar_of_windows(&windows, 100, 130);
+        // three identical rows: one rule for a row of windows
+        let text = g.to_text();
+        assert!(text.contains("Columns1"), "{text}");
+        assert!(!text.contains("Columns2"), "{text}");
+        let parse = rasterize(&g.derive(100.0, 130.0).expect("derives"), 100, 130);
+        assert_eq!(parse.windows.len(), 9);
+    }
+
+    #[test]
+    fn resized_facades_keep_their_windows_apart() {
+        let windows: Vec<Rect> = (0..4)
+            .map(|j| rect(10 + 30 * j, 10, 30 + 30 * j, 40))
+            .collect();
+        let g = grammar_of_windows(&windows, 130, 60);
+        for (w, h) in [(97.5, 45.0), (195.0, 90.0)] {
+            let leaves = g.derive(w, h).expect("derives");
+            let wins: Vec<_> = leaves.iter().filter(|l| l.class == Class::Window).collect();
+            assert_eq!(wins.len(), 4);
+            for p in wins.windows(2) {
+                assert!(p[0].scope.x1 <= p[1].scope.x0 + 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn no_windows_is_plain_wall() {
+        let g = grammar_of_windows(&[], 50, 40);
+        let leaves = g.derive(50.0, 40.0).expect("derives");
+        assert_eq!(leaves.len(), 1);
+        assert_eq!(leaves[0].class, Class::Wall);
+    }
+}
