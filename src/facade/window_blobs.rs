@@ -3,7 +3,7 @@
 //! connected pieces of such pixels whose bounding box has a window's size, shape and fill,
 //! and a candidate is kept only when another one of about its size stands in its row or its
 //! column (windows repeat: Müller et al.'s prior, without asking for one global lattice, which
-//! street photos of several buildings break). The parameters were chosen on the tuning half of
+//! street photos of several buildings break) and when its outline is a sharp step (a frame). The parameters were chosen on the tuning half of
 //! the labelled photos (`scripts/facades_eval.rhai --set half=tune`).
 
 use super::gray::Gray;
@@ -28,6 +28,9 @@ pub struct BlobParams {
     /// Greatest relative difference of height and of width of two candidates that support
     /// each other.
     pub similar: f64,
+    /// Least mean grey step across the candidate's outline (a window has a sharp frame; a
+    /// shadow or a patch of dark wall fades out).
+    pub border: f64,
 }
 
 impl Default for BlobParams {
@@ -40,6 +43,7 @@ impl Default for BlobParams {
             aspect: (0.25, 4.0),
             align: 0.3,
             similar: 0.5,
+            border: 11.0,
         }
     }
 }
@@ -136,6 +140,29 @@ pub fn pieces(mask: &[bool], w: usize, h: usize) -> Vec<(Rect, u64)> {
     out
 }
 
+/// Mean absolute grey step across the outline of `r`: between each pixel of its first and
+/// last rows and columns and its neighbour outside (clamped at the image's edge).
+pub fn border_step(img: &Gray, r: &Rect) -> f64 {
+    let at = |x: u32, y: u32| img.at(x.min(img.width - 1), y.min(img.height - 1)) as f64;
+    let step = |a: f64, b: f64| (a - b).abs();
+    let (mut sum, mut n) = (0.0, 0.0);
+    for y in r.y0..r.y1 {
+        sum += step(at(r.x0, y), at(r.x0.saturating_sub(1), y));
+        sum += step(at(r.x1, y), at(r.x1 - 1, y));
+        n += 2.0;
+    }
+    for x in r.x0..r.x1 {
+        sum += step(at(x, r.y0), at(x, r.y0.saturating_sub(1)));
+        sum += step(at(x, r.y1), at(x, r.y1 - 1));
+        n += 2.0;
+    }
+    if n > 0.0 {
+        sum / n
+    } else {
+        0.0
+    }
+}
+
 /// Whether two candidates support each other: about the same size, in one row or column.
 fn supports(a: &Rect, b: &Rect, p: &BlobParams) -> bool {
     let (ha, hb) = ((a.y1 - a.y0) as f64, (b.y1 - b.y0) as f64);
@@ -178,6 +205,7 @@ pub fn detect_windows(img: &Gray, region: &Rect, p: &BlobParams) -> Vec<Rect> {
                 .any(|(j, b)| j != i && supports(a, b, p))
         })
         .map(|(_, r)| *r)
+        .filter(|r| border_step(img, r) >= p.border)
         .collect()
 }
 
@@ -225,6 +253,35 @@ mod tests {
         let img = facade(200, 200, &[rect(80, 80, 105, 115)]);
         let found = detect_windows(&img, &rect(0, 0, 200, 200), &BlobParams::default());
         assert!(found.is_empty(), "{found:?}");
+    }
+
+    #[test]
+    fn soft_dark_patches_without_a_frame_are_no_windows() {
+        // a row of three shadows darkening gradually towards their centres (8 grey levels per
+        // pixel): dark, repeated, window-sized, but with no sharp outline
+        let (w, h) = (220u32, 120u32);
+        let mut data = vec![200u8; (w * h) as usize];
+        for cx in [50i64, 110, 170] {
+            for y in 0..h as i64 {
+                for x in 0..w as i64 {
+                    let d = (x - cx).abs().max((y - 60).abs()) as f64;
+                    let v = 200.0 - 160.0 * (1.0 - d / 20.0).max(0.0);
+                    let i = (y * w as i64 + x) as usize;
+                    data[i] = data[i].min(v.round() as u8);
+                }
+            }
+        }
+        let img = Gray {
+            width: w,
+            height: h,
+            data,
+        };
+        let p = BlobParams::default();
+        let found = detect_windows(&img, &rect(0, 0, w, h), &p);
+        assert!(found.is_empty(), "{found:?}");
+        // without the outline test they would pass
+        let lax = BlobParams { border: 0.0, ..p };
+        assert_eq!(detect_windows(&img, &rect(0, 0, w, h), &lax).len(), 3);
     }
 
     #[test]
