@@ -14,7 +14,7 @@ use emilion::facade::gray::Gray;
 use emilion::facade::homography::{warp_gray, warp_labels, Homography};
 use emilion::facade::outputs::{write_outputs, OutputOptions};
 use emilion::facade::parse::{rasterize, round_trip};
-use emilion::facade::{Class, PixelScore};
+use emilion::facade::{Class, LabelMap, PixelScore};
 use emilion::geometry::read_obj_surface;
 use nalgebra::Matrix3;
 
@@ -145,4 +145,43 @@ fn a_picture_without_a_facade_gives_a_clear_message_and_its_overlay() {
     // an unreadable photo is an error naming the file
     let e = analyze(&dir.join("missing.jpg"), &Options::default()).unwrap_err();
     assert!(e.to_string().contains("missing.jpg"));
+}
+
+#[test]
+fn a_street_photo_is_parsed_into_its_windows_and_built_at_three_widths() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/facades/labelmefacade");
+    let name = "spatial_envelope_256x256_static_8outdoorcategories__insidecity_urb267";
+    let photo = data.join(format!("images/{name}.jpg"));
+    let a = analyze(&photo, &Options::default()).unwrap();
+    let (g, s) = a.parse.as_ref().expect("parses");
+    // the floors × tiles lattice does not fit this street: the grammar is the windows'
+    assert!(s.from_windows, "{} windows found", s.windows.len());
+    let (rw, rh) = (a.gray.width, a.gray.height);
+    let p = rasterize(&g.derive(rw as f64, rh as f64).unwrap(), rw, rh);
+    eprintln!(
+        "{} windows found, {} in the parse",
+        s.windows.len(),
+        p.windows.len()
+    );
+    assert!(s.windows.len() >= 10);
+    // the XY cuts lose only windows that overlap another
+    for w in s.windows.iter().filter(|w| !p.windows.contains(w)) {
+        assert!(
+            s.windows.iter().any(|v| v != w && v.intersection(w) > 0),
+            "{w:?} lost"
+        );
+    }
+    assert_eq!(round_trip(g, rw, rh).unwrap(), 1.0);
+    let truth = LabelMap::read_labelmefacade(&data.join(format!("labels/{name}.png"))).unwrap();
+    let t = warp_labels(&truth, &a.homography, rw, rh).unwrap();
+    let iou = PixelScore::of(&p.labels, &t).unwrap().iou(Class::Window);
+    eprintln!("window IoU {iou:.3}");
+    assert!(iou > 0.3, "window IoU {iou}");
+    // closed facades at three widths (write_outputs checks each mesh is closed)
+    let dir = out_dir("facade_street");
+    write_outputs(&a, &dir, "street", &OutputOptions::default()).unwrap();
+    for f in ["street_w1.obj", "street_w0.75.obj", "street_w1.5.obj"] {
+        let (v, t) = read_obj_surface(&dir.join(f)).unwrap();
+        assert!(!v.is_empty() && !t.is_empty(), "{f}");
+    }
 }

@@ -1,7 +1,8 @@
 //! The grammar of a facade whose windows were found one by one
 //! ([`super::window_blobs`]), by recursive XY cuts: the facade is split top to bottom into
-//! wall and the rows of windows (groups that overlap vertically), each row left to right into
-//! wall and columns, and so on until a part is one window or wall. Windows keep their size
+//! wall and rows of windows (groups that overlap vertically; rules `RowN`, `split(x)`), each
+//! row left to right into wall and stacks (groups that overlap horizontally; rules `StackN`,
+//! `split(y)`), and so on until a part is one window or wall. Windows keep their size
 //! (fixed parts), the wall between them floats, so the rules regenerate the parse exactly at
 //! the photo's size and spread or squeeze the windows at other sizes. Identical parts share
 //! one rule.
@@ -82,7 +83,7 @@ fn rule_of(rules: &mut BTreeMap<String, Body>, scope: Rect, windows: &[Rect]) ->
         [w] if *w == scope => return "Window".into(),
         _ => {}
     }
-    for (dir, base) in [(Dir::Y, "Rows"), (Dir::X, "Columns")] {
+    for (dir, base) in [(Dir::Y, "Stack"), (Dir::X, "Row")] {
         let g = groups(windows, dir);
         let (a, b) = span(&scope, dir);
         if g.len() == 1 && g[0].0 == (a, b) {
@@ -211,8 +212,8 @@ mod tests {
         let g = grammar_of_windows(&windows, 100, 130);
         // three identical rows: one rule for a row of windows
         let text = g.to_text();
-        assert!(text.contains("Columns1"), "{text}");
-        assert!(!text.contains("Columns2"), "{text}");
+        assert!(text.contains("Row1 --> split(x)"), "{text}");
+        assert!(!text.contains("Row2"), "{text}");
         let parse = rasterize(&g.derive(100.0, 130.0).expect("derives"), 100, 130);
         assert_eq!(parse.windows.len(), 9);
     }
