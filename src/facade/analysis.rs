@@ -207,7 +207,7 @@ pub fn analyze(path: &Path, opts: &Options) -> Result<Analysis, FacadeError> {
     });
     match &parsed {
         Ok((_, s)) => {
-            for (name, v) in ["floors", "tiles", "irreducible", "window"]
+            for (name, v) in ["floors", "tiles", "irreducible", "window", "windows"]
                 .into_iter()
                 .zip(s.seconds)
             {

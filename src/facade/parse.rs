@@ -73,8 +73,9 @@ pub struct Structure {
     /// layout's windows agree with them less than [`GRID_AGREEMENT`]; otherwise the grammar
     /// is the layout's (floors and tiles that repeat).
     pub from_windows: bool,
-    /// Seconds spent in: floor search, tile search, irreducible tile, window.
-    pub seconds: [f64; 4],
+    /// Seconds spent in: floor search, tile search, irreducible tile, window (the layout's,
+    /// with synchronisation), windows one by one (with the choice of grammar).
+    pub seconds: [f64; 5],
 }
 
 /// Least window contrast of a cell, as a share of the irreducible tile's, for the cell to
@@ -175,8 +176,8 @@ pub fn parse_region(
         window = tile_window(&tile, tw, fh, priors.window);
     }
     let (row_starts, col_starts) = synchronise(img, &rows, &cols, &mut present, &window, fh, tw);
-    let windows = detect_windows(full, &region, &BlobParams::default());
     let t4 = Instant::now();
+    let windows = detect_windows(full, &region, &BlobParams::default());
     let off = |v: &[u32], o: u32| v.iter().map(|&x| x + o).collect::<Vec<u32>>();
     let offf = |v: Vec<f64>, o: u32| v.into_iter().map(|x| x + o as f64).collect::<Vec<f64>>();
     let structure = Structure {
@@ -199,17 +200,20 @@ pub fn parse_region(
             (t2 - t1).as_secs_f64(),
             (t3 - t2).as_secs_f64(),
             (t4 - t3).as_secs_f64(),
+            0.0,
         ],
     };
     let mut structure = structure;
     let grid = grammar_of(&structure, full.width, full.height);
-    if structure.windows.is_empty()
+    let grammar = if structure.windows.is_empty()
         || window_agreement(&grid, &structure.windows, full.width, full.height) >= GRID_AGREEMENT
     {
-        return Ok((grid, structure));
-    }
-    structure.from_windows = true;
-    let grammar = grammar_of_windows(&structure.windows, full.width, full.height);
+        grid
+    } else {
+        structure.from_windows = true;
+        grammar_of_windows(&structure.windows, full.width, full.height)
+    };
+    structure.seconds[4] = t4.elapsed().as_secs_f64();
     Ok((grammar, structure))
 }
 
