@@ -37,6 +37,12 @@ pub struct Options {
     pub priors: Priors,
     /// Least repetition strength (relative MI of floors and of tiles) for a facade.
     pub min_strength: f64,
+    /// Least number of windows found one by one (each repeated in its row or column) that
+    /// makes a facade of a photo whose floors and tiles repeat less than `min_strength` but
+    /// at least `weak_strength`.
+    pub min_windows: usize,
+    /// See `min_windows` (noise repeats with a strength of about 0.012).
+    pub weak_strength: f64,
 }
 
 impl Default for Options {
@@ -45,6 +51,8 @@ impl Default for Options {
             rectify: Rectify::Auto,
             priors: Priors::default(),
             min_strength: 0.03,
+            min_windows: 8,
+            weak_strength: 0.02,
         }
     }
 }
@@ -196,10 +204,16 @@ pub fn analyze(path: &Path, opts: &Options) -> Result<Analysis, FacadeError> {
     let region = photo_region(&homography, (w0, h0), (gray.width, gray.height));
     let parsed = parse_region(&gray, region, &opts.priors).and_then(|(g, s)| {
         let strength = s.strength.0.min(s.strength.1);
-        if strength < opts.min_strength {
+        let windowed = strength >= opts.weak_strength && s.windows.len() >= opts.min_windows;
+        if strength < opts.min_strength && !windowed {
             Err(format!(
-                "no facade: floors and tiles hardly repeat (relative MI {:.3} and {:.3}, need ≥ {})",
-                s.strength.0, s.strength.1, opts.min_strength
+                "no facade: floors and tiles hardly repeat (relative MI {:.3} and {:.3}, need ≥ {}, or ≥ {} with {} repeated windows; {} found)",
+                s.strength.0,
+                s.strength.1,
+                opts.min_strength,
+                opts.weak_strength,
+                opts.min_windows,
+                s.windows.len()
             ))
         } else {
             Ok((g, s))
