@@ -16,6 +16,11 @@ pub struct Rect {
 }
 
 impl Rect {
+    /// Columns `x0..x1`, rows `y0..y1`.
+    pub const fn new(x0: u32, y0: u32, x1: u32, y1: u32) -> Self {
+        Rect { x0, y0, x1, y1 }
+    }
+
     /// Pixels covered.
     pub fn area(&self) -> u64 {
         self.x1.saturating_sub(self.x0) as u64 * self.y1.saturating_sub(self.y0) as u64

@@ -195,17 +195,13 @@ fn ratio(a: u64, b: u64) -> f64 {
 mod tests {
     use super::*;
 
-    fn r(x0: u32, y0: u32, x1: u32, y1: u32) -> Rect {
-        Rect { x0, y0, x1, y1 }
-    }
-
     #[test]
     fn pixel_scores_leave_ignored_pixels_out() {
         let mut truth = LabelMap::filled(10, 10, Class::Wall);
-        truth.paint(&r(0, 0, 4, 5), Class::Window); // 20 window pixels
-        truth.paint(&r(0, 9, 10, 10), Class::Ignore); // 10 ignored
+        truth.paint(&Rect::new(0, 0, 4, 5), Class::Window); // 20 window pixels
+        truth.paint(&Rect::new(0, 9, 10, 10), Class::Ignore); // 10 ignored
         let mut pred = LabelMap::filled(10, 10, Class::Wall);
-        pred.paint(&r(2, 0, 6, 5), Class::Window); // 10 right, 10 wrong
+        pred.paint(&Rect::new(2, 0, 6, 5), Class::Window); // 10 right, 10 wrong
         let s = PixelScore::of(&pred, &truth).unwrap();
         // 90 scored pixels, 20 wrong
         assert!((s.accuracy() - 70.0 / 90.0).abs() < 1e-12);
@@ -220,20 +216,24 @@ mod tests {
     fn detection_counts_matches_at_half_overlap() {
         let truth = [
             Instance {
-                rect: r(0, 0, 10, 10),
+                rect: Rect::new(0, 0, 10, 10),
                 dont_care: false,
             },
             Instance {
-                rect: r(20, 0, 30, 10),
+                rect: Rect::new(20, 0, 30, 10),
                 dont_care: false,
             },
             Instance {
-                rect: r(40, 0, 50, 10),
+                rect: Rect::new(40, 0, 50, 10),
                 dont_care: true,
             },
         ];
         // one good hit, one too-shifted guess (IoU 1/3), one on the don't-care window
-        let pred = [r(1, 0, 11, 10), r(25, 0, 35, 10), r(40, 0, 50, 10)];
+        let pred = [
+            Rect::new(1, 0, 11, 10),
+            Rect::new(25, 0, 35, 10),
+            Rect::new(40, 0, 50, 10),
+        ];
         let s = DetectionScore::of(&pred, &truth);
         assert_eq!(
             (s.true_positives, s.false_positives, s.false_negatives),
@@ -245,15 +245,15 @@ mod tests {
         // the right window (IoU 0.25)
         let truth2 = [
             Instance {
-                rect: r(0, 0, 10, 10),
+                rect: Rect::new(0, 0, 10, 10),
                 dont_care: false,
             },
             Instance {
-                rect: r(6, 0, 16, 10),
+                rect: Rect::new(6, 0, 16, 10),
                 dont_care: false,
             },
         ];
-        let pred2 = [r(3, 0, 13, 10), r(0, 0, 10, 10)];
+        let pred2 = [Rect::new(3, 0, 13, 10), Rect::new(0, 0, 10, 10)];
         let s2 = DetectionScore::of(&pred2, &truth2);
         assert_eq!(s2.true_positives, 2, "{s2:?}");
         assert_eq!(DetectionScore::of(&[], &[]).f1(), 1.0);

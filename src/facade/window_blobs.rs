@@ -230,19 +230,15 @@ mod tests {
         }
     }
 
-    fn rect(x0: u32, y0: u32, x1: u32, y1: u32) -> Rect {
-        Rect { x0, y0, x1, y1 }
-    }
-
     #[test]
     fn a_grid_of_dark_windows_is_found_exactly() {
         let windows: Vec<Rect> = (0..3)
             .flat_map(|i| {
-                (0..4).map(move |j| rect(20 + 50 * j, 30 + 60 * i, 45 + 50 * j, 65 + 60 * i))
+                (0..4).map(move |j| Rect::new(20 + 50 * j, 30 + 60 * i, 45 + 50 * j, 65 + 60 * i))
             })
             .collect();
         let img = facade(220, 200, &windows);
-        let region = rect(0, 0, 220, 200);
+        let region = Rect::new(0, 0, 220, 200);
         let found = detect_windows(&img, &region, &BlobParams::default());
         assert_eq!(found, windows);
     }
@@ -250,8 +246,8 @@ mod tests {
     #[test]
     fn a_lone_dark_patch_is_no_window() {
         // one window-sized patch with nothing like it in its row or column
-        let img = facade(200, 200, &[rect(80, 80, 105, 115)]);
-        let found = detect_windows(&img, &rect(0, 0, 200, 200), &BlobParams::default());
+        let img = facade(200, 200, &[Rect::new(80, 80, 105, 115)]);
+        let found = detect_windows(&img, &Rect::new(0, 0, 200, 200), &BlobParams::default());
         assert!(found.is_empty(), "{found:?}");
     }
 
@@ -277,11 +273,11 @@ mod tests {
             data,
         };
         let p = BlobParams::default();
-        let found = detect_windows(&img, &rect(0, 0, w, h), &p);
+        let found = detect_windows(&img, &Rect::new(0, 0, w, h), &p);
         assert!(found.is_empty(), "{found:?}");
         // without the outline test they would pass
         let lax = BlobParams { border: 0.0, ..p };
-        assert_eq!(detect_windows(&img, &rect(0, 0, w, h), &lax).len(), 3);
+        assert_eq!(detect_windows(&img, &Rect::new(0, 0, w, h), &lax).len(), 3);
     }
 
     #[test]
@@ -290,7 +286,7 @@ mod tests {
         let mask = [true, false, false, true];
         let p = pieces(&mask, 2, 2);
         assert_eq!(p.len(), 2);
-        assert_eq!(p[0], (rect(0, 0, 1, 1), 1));
-        assert_eq!(p[1], (rect(1, 1, 2, 2), 1));
+        assert_eq!(p[0], (Rect::new(0, 0, 1, 1), 1));
+        assert_eq!(p[1], (Rect::new(1, 1, 2, 2), 1));
     }
 }

@@ -167,22 +167,18 @@ mod tests {
     use super::*;
     use crate::facade::parse::{rasterize, round_trip};
 
-    fn rect(x0: u32, y0: u32, x1: u32, y1: u32) -> Rect {
-        Rect { x0, y0, x1, y1 }
-    }
-
     #[test]
     fn the_rules_paint_the_windows_back_exactly() {
         // staggered rows and columns (no one band holds a whole row), and one window inside
         // another's extent that no cut can separate: it is dropped
         let windows = [
-            rect(10, 20, 30, 50),
-            rect(40, 25, 60, 50),
-            rect(70, 20, 90, 50),
-            rect(55, 30, 65, 45),
-            rect(10, 45, 30, 110),
-            rect(40, 60, 60, 90),
-            rect(70, 80, 90, 110),
+            Rect::new(10, 20, 30, 50),
+            Rect::new(40, 25, 60, 50),
+            Rect::new(70, 20, 90, 50),
+            Rect::new(55, 30, 65, 45),
+            Rect::new(10, 45, 30, 110),
+            Rect::new(40, 60, 60, 90),
+            Rect::new(70, 80, 90, 110),
         ];
         let g = grammar_of_windows(&windows, 100, 120);
         let leaves = g.derive(100.0, 120.0).expect("derives");
@@ -192,12 +188,12 @@ mod tests {
         let mut want: Vec<Rect> = windows
             .iter()
             .copied()
-            .filter(|r| *r != rect(55, 30, 65, 45))
+            .filter(|r| *r != Rect::new(55, 30, 65, 45))
             .collect();
         want.sort_by_key(|r| (r.y0, r.x0));
         // the window at 10..30 × 20..50 and the one below it overlap in rows 45..50: the
         // smaller of the two goes
-        want.retain(|r| *r != rect(10, 20, 30, 50));
+        want.retain(|r| *r != Rect::new(10, 20, 30, 50));
         assert_eq!(got, want);
         assert_eq!(round_trip(&g, 100, 120).expect("round trip"), 1.0);
     }
@@ -206,7 +202,7 @@ mod tests {
     fn repeated_windows_share_their_rule() {
         let windows: Vec<Rect> = (0..3)
             .flat_map(|i| {
-                (0..3).map(move |j| rect(10 + 30 * j, 10 + 40 * i, 30 + 30 * j, 40 + 40 * i))
+                (0..3).map(move |j| Rect::new(10 + 30 * j, 10 + 40 * i, 30 + 30 * j, 40 + 40 * i))
             })
             .collect();
         let g = grammar_of_windows(&windows, 100, 130);
@@ -221,7 +217,7 @@ mod tests {
     #[test]
     fn resized_facades_keep_their_windows_apart() {
         let windows: Vec<Rect> = (0..4)
-            .map(|j| rect(10 + 30 * j, 10, 30 + 30 * j, 40))
+            .map(|j| Rect::new(10 + 30 * j, 10, 30 + 30 * j, 40))
             .collect();
         let g = grammar_of_windows(&windows, 130, 60);
         for (w, h) in [(97.5, 45.0), (195.0, 90.0)] {
