@@ -13,6 +13,7 @@ use super::parse_grammar::grammar_of;
 use super::rect::Rect;
 use super::repetition::{detect, Axis};
 use super::report::FacadeParse;
+use super::score::PixelScore;
 use super::window_blobs::{detect_windows, BlobParams};
 use super::window_grammar::grammar_of_windows;
 
@@ -180,7 +181,7 @@ pub fn parse_region(
     let windows = detect_windows(full, &region, &BlobParams::default());
     let off = |v: &[u32], o: u32| v.iter().map(|&x| x + o).collect::<Vec<u32>>();
     let offf = |v: Vec<f64>, o: u32| v.into_iter().map(|x| x + o as f64).collect::<Vec<f64>>();
-    let structure = Structure {
+    let mut structure = Structure {
         floor: fh,
         floor_splits: off(&floors.splits, region.y0),
         tile: tw,
@@ -203,7 +204,6 @@ pub fn parse_region(
             0.0,
         ],
     };
-    let mut structure = structure;
     let grid = grammar_of(&structure, full.width, full.height);
     let grammar = if structure.windows.is_empty()
         || window_agreement(&grid, &structure.windows, full.width, full.height) >= GRID_AGREEMENT
@@ -231,17 +231,7 @@ fn window_agreement(g: &Grammar, windows: &[Rect], width: u32, height: u32) -> f
     for r in windows {
         found.paint(r, Class::Window);
     }
-    let (mut both, mut either) = (0u64, 0u64);
-    for (a, b) in grid.classes.iter().zip(&found.classes) {
-        let (a, b) = (*a == Class::Window, *b == Class::Window);
-        both += (a && b) as u64;
-        either += (a || b) as u64;
-    }
-    if either == 0 {
-        0.0
-    } else {
-        both as f64 / either as f64
-    }
+    PixelScore::of(&grid, &found).map_or(0.0, |s| s.iou(Class::Window))
 }
 
 /// Least difference (grey levels) between a window and its wall for a cell to keep its window.
