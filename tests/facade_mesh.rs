@@ -382,6 +382,7 @@ fn leaf(x0: f64, y0: f64, x1: f64, y1: f64, class: Class) -> Leaf {
         scope,
         class,
         source: scope,
+        element: None,
     }
 }
 

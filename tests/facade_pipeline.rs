@@ -81,7 +81,7 @@ fn perspective_facade_is_rectified_parsed_and_built() {
     }
     let rules = std::fs::read_to_string(dir.join("view.cga")).unwrap();
     assert!(
-        rules.contains("Floors -->") && rules.contains("--> window"),
+        rules.contains("Floors -->") && rules.contains("--> insert(window, window_plain)"),
         "{rules}"
     );
 }

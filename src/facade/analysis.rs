@@ -8,6 +8,8 @@ use std::time::Instant;
 
 use image::RgbImage;
 
+use super::element_library::Library;
+use super::element_match::{recognise_elements, ElementMatch};
 use super::error::FacadeError;
 use super::grammar::Grammar;
 use super::gray::{read_rgb, Gray};
@@ -72,6 +74,9 @@ pub struct Analysis {
     pub parse: Result<(Grammar, Structure), String>,
     /// Why rectification failed, when it did (the analysis then went on unrectified).
     pub rectification_failed: Option<String>,
+    /// The library element recognised for the windows (and doors) of the parse, which its
+    /// grammar inserts; empty when the parse failed.
+    pub elements: Vec<ElementMatch>,
     /// (stage, seconds), in order.
     pub seconds: Vec<(&'static str, f64)>,
 }
@@ -219,14 +224,23 @@ pub fn analyze(path: &Path, opts: &Options) -> Result<Analysis, FacadeError> {
             Ok((g, s))
         }
     });
-    match &parsed {
-        Ok((_, s)) => {
+    let mut parsed = parsed;
+    let mut elements = Vec::new();
+    match &mut parsed {
+        Ok((g, s)) => {
             for (name, v) in ["floors", "tiles", "irreducible", "window", "windows"]
                 .into_iter()
                 .zip(s.seconds)
             {
                 seconds.push((name, v));
             }
+            let t = Instant::now();
+            let library = Library::builtin().map_err(|message| FacadeError::File {
+                path: "assets/facade_elements".into(),
+                message,
+            })?;
+            elements = recognise_elements(g, &gray, &library);
+            seconds.push(("elements", t.elapsed().as_secs_f64()));
         }
         Err(_) => seconds.push(("parse", t.elapsed().as_secs_f64())),
     }
@@ -237,6 +251,7 @@ pub fn analyze(path: &Path, opts: &Options) -> Result<Analysis, FacadeError> {
         gray,
         parse: parsed,
         rectification_failed: failed,
+        elements,
         seconds,
     })
 }

@@ -1,7 +1,7 @@
 //! Files of facade meshes ([`FacadeMesh`]): Wavefront OBJ with its MTL material library, and
 //! binary glTF 2.0 with PBR materials and the photo embedded as texture
 //! (`facade-reconstruction.md` §5.4 "Geometry"). One group / primitive per [`Surface`]
-//! (wall, window, door …, reveal, shell), so tools can pick parts apart. This module owns the
+//! (wall, window, door …, reveal, shell, element), so tools can pick parts apart. This module owns the
 //! file formats and the look of each surface; the geometry comes from
 //! [`super::facade_mesh`]. Writes are atomic (temporary file, then rename) and errors name
 //! the file.
@@ -38,7 +38,8 @@ pub struct Appearance {
 }
 
 /// The look of each surface: light stone walls, dark blue-grey glass, brown doors, grey
-/// metal balconies, slate for background (roof), stone reveals and shell.
+/// metal balconies, slate for background (roof), stone reveals and shell, white-painted
+/// elements (frames, mullions, panels).
 pub fn appearance(surface: Surface) -> Appearance {
     let (srgb, metallic, roughness) = match surface {
         Surface::Front(Class::Wall) => ([0.80, 0.76, 0.68], 0.0, 0.9),
@@ -49,6 +50,7 @@ pub fn appearance(surface: Surface) -> Appearance {
         Surface::Front(Class::Ignore) => ([0.60, 0.60, 0.60], 0.0, 0.9),
         Surface::Reveal => ([0.70, 0.66, 0.58], 0.0, 0.9),
         Surface::Shell => ([0.74, 0.70, 0.62], 0.0, 0.95),
+        Surface::Element => ([0.93, 0.93, 0.90], 0.0, 0.5),
     };
     Appearance {
         srgb,

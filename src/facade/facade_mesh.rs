@@ -95,11 +95,14 @@ pub enum Surface {
     Reveal,
     /// The slab's outer sides and back.
     Shell,
+    /// Inserted elements (window frames, mullions, door panels): closed solids of their own
+    /// ([`super::element_library::insert_elements`]).
+    Element,
 }
 
 impl Surface {
     /// Every surface, in the order groups are stored.
-    pub const ALL: [Surface; 8] = [
+    pub const ALL: [Surface; 9] = [
         Surface::Front(Class::Wall),
         Surface::Front(Class::Window),
         Surface::Front(Class::Door),
@@ -108,20 +111,22 @@ impl Surface {
         Surface::Front(Class::Ignore),
         Surface::Reveal,
         Surface::Shell,
+        Surface::Element,
     ];
 
-    /// Material name: the class name for fronts, `reveal`, `shell`.
+    /// Material name: the class name for fronts, `reveal`, `shell`, `element`.
     pub fn name(self) -> &'static str {
         match self {
             Surface::Front(c) => c.name(),
             Surface::Reveal => "reveal",
             Surface::Shell => "shell",
+            Surface::Element => "element",
         }
     }
 
-    /// Whether it shows the photo (fronts and reveals); the shell is plain.
+    /// Whether it shows the photo (fronts and reveals); the shell and elements are plain.
     pub fn textured(self) -> bool {
-        self != Surface::Shell
+        !matches!(self, Surface::Shell | Surface::Element)
     }
 
     fn order(self) -> usize {
@@ -588,6 +593,7 @@ mod tests {
                 y1: 10.0,
             },
             class: Class::Window,
+            element: None,
         };
         // the middle of the scope is the middle of the source; clamped to the leaf
         assert_eq!(leaf_uv(&l, 15.0, 2.5, (10.0, 20.0)), [0.25, 0.375]);

@@ -106,8 +106,16 @@ pub enum Body {
         /// The tile's rule.
         rule: String,
     },
-    /// A terminal shape of a class (an element of the library is inserted there).
+    /// A terminal shape of a class.
     Leaf(Class),
+    /// A terminal shape of a class with an element of the library inserted in it (CGA's `i`):
+    /// a window type, a door ([`super::element_library`]).
+    Insert {
+        /// The class.
+        class: Class,
+        /// The element's name in the library.
+        element: String,
+    },
 }
 
 /// A derived terminal shape: where it is, what it is, and where it came from in the parsed
@@ -121,6 +129,8 @@ pub struct Leaf {
     pub class: Class,
     /// The corresponding rectangle of the parsed photo.
     pub source: Scope,
+    /// The inserted element, as an index into [`Grammar::elements`]; `None` for a plain leaf.
+    pub element: Option<usize>,
 }
 
 /// A facade grammar: named rules and the axiom's size.
@@ -158,8 +168,40 @@ impl Grammar {
             x1: self.size.0,
             y1: self.size.1,
         };
-        self.expand(&self.axiom, scope, source, 0, &mut out)?;
+        let elements = self.elements();
+        self.expand(&self.axiom, scope, source, 0, &elements, &mut out)?;
         Ok(out)
+    }
+
+    /// The distinct elements the rules insert, sorted by name: what [`Leaf::element`] indexes.
+    pub fn elements(&self) -> Vec<String> {
+        let mut v: Vec<String> = self
+            .rules
+            .values()
+            .filter_map(|b| match b {
+                Body::Insert { element, .. } => Some(element.clone()),
+                _ => None,
+            })
+            .collect();
+        v.sort();
+        v.dedup();
+        v
+    }
+
+    /// Makes every plain leaf of `class` insert `element` (the rule file then says
+    /// `insert(class, element)`); returns how many rules changed.
+    pub fn insert_element(&mut self, class: Class, element: &str) -> usize {
+        let mut n = 0;
+        for body in self.rules.values_mut() {
+            if *body == Body::Leaf(class) {
+                *body = Body::Insert {
+                    class,
+                    element: element.to_string(),
+                };
+                n += 1;
+            }
+        }
+        n
     }
 
     fn expand(
@@ -168,6 +210,7 @@ impl Grammar {
         scope: Scope,
         source: Scope,
         depth: usize,
+        elements: &[String],
         out: &mut Vec<Leaf>,
     ) -> Result<(), String> {
         if depth > MAX_DEPTH {
@@ -184,6 +227,13 @@ impl Grammar {
                 scope,
                 class: *class,
                 source,
+                element: None,
+            }),
+            Body::Insert { class, element } => out.push(Leaf {
+                scope,
+                class: *class,
+                source,
+                element: elements.binary_search(element).ok(),
             }),
             Body::Split { dir, parts } => {
                 let sizes: Vec<Size> = parts.iter().map(|p| p.0).collect();
@@ -199,6 +249,7 @@ impl Grammar {
                         scope.with(*dir, cuts[k], cuts[k + 1]),
                         source.with(*dir, scuts[k], scuts[k + 1]),
                         depth + 1,
+                        elements,
                         out,
                     )?;
                 }
@@ -222,6 +273,7 @@ impl Grammar {
                         scope.with(*dir, a + k as f64 * step, a + (k + 1) as f64 * step),
                         source.with(*dir, sa + ks as f64 * sstep, sa + (ks + 1) as f64 * sstep),
                         depth + 1,
+                        elements,
                         out,
                     )?;
                 }
@@ -231,7 +283,8 @@ impl Grammar {
     }
 
     /// The rule file: one rule per line, `Name --> split(y) { 12: A | ~30: B }`,
-    /// `Name --> repeat(x, 43.5) { Tile }`, `Name --> window`; the axiom first, with the
+    /// `Name --> repeat(x, 43.5) { Tile }`, `Name --> window`,
+    /// `Name --> insert(window, window_cross)`; the axiom first, with the
     /// parsed size in a header comment.
     pub fn to_text(&self) -> String {
         let mut s = String::new();
@@ -249,6 +302,9 @@ impl Grammar {
             match &self.rules[name] {
                 Body::Leaf(c) => {
                     let _ = writeln!(s, "{}", c.name());
+                }
+                Body::Insert { class, element } => {
+                    let _ = writeln!(s, "insert({}, {element})", class.name());
                 }
                 Body::Repeat { dir, size, rule } => {
                     let _ = writeln!(s, "repeat({}, {}) {{ {rule} }}", dir.name(), fmt_num(*size));
@@ -301,6 +357,23 @@ impl Grammar {
             let rhs = rhs.trim();
             let body = if let Some(class) = Class::from_name(rhs) {
                 Body::Leaf(class)
+            } else if let Some(args) = rhs
+                .strip_prefix("insert(")
+                .and_then(|a| a.strip_suffix(')'))
+            {
+                let (c, e) = args
+                    .split_once(',')
+                    .ok_or_else(|| err("insert takes (class, element)"))?;
+                let class = Class::from_name(c.trim())
+                    .ok_or_else(|| err("insert's class is window, wall, door, balcony, …"))?;
+                let element = e.trim();
+                if element.is_empty() || !element.chars().all(|c| c.is_alphanumeric() || c == '_') {
+                    return Err(err("an element name is letters, digits and _"));
+                }
+                Body::Insert {
+                    class,
+                    element: element.to_string(),
+                }
             } else {
                 let (head, inner) = rhs
                     .split_once('{')
@@ -368,7 +441,7 @@ impl Grammar {
         }
         for (name, body) in &self.rules {
             let refs: Vec<&String> = match body {
-                Body::Leaf(_) => Vec::new(),
+                Body::Leaf(_) | Body::Insert { .. } => Vec::new(),
                 Body::Repeat { rule, size, .. } => {
                     if !(*size > 0.0 && size.is_finite()) {
                         return Err(format!("rule {name}: repeat size {size} must be positive"));
@@ -498,6 +571,34 @@ mod tests {
                 (l.scope.width() - 24.0).abs() < 1e-9 && (l.scope.height() - 33.0).abs() < 1e-9
             );
         }
+    }
+
+    #[test]
+    fn inserted_elements_read_back_and_reach_the_leaves() {
+        let mut g = sample();
+        assert_eq!(g.insert_element(Class::Window, "window_cross"), 1);
+        assert_eq!(g.insert_element(Class::Door, "door_panel"), 1);
+        let text = g.to_text();
+        assert!(
+            text.contains("Window --> insert(window, window_cross)"),
+            "{text}"
+        );
+        let back = Grammar::parse(&text).expect("reads inserts");
+        assert_eq!(back, g);
+        let names = back.elements();
+        assert_eq!(names, vec!["door_panel", "window_cross"]);
+        for l in back.derive(430.0, 300.0).expect("derives") {
+            let want = match l.class {
+                Class::Window => Some(1),
+                Class::Door => Some(0),
+                _ => None,
+            };
+            assert_eq!(l.element, want, "{l:?}");
+        }
+        let e = Grammar::parse("// axiom F size 1 1\nF --> insert(window, a-b)\n").unwrap_err();
+        assert!(e.contains("line 2") && e.contains("element name"), "{e}");
+        let e = Grammar::parse("// axiom F size 1 1\nF --> insert(chimney, pot)\n").unwrap_err();
+        assert!(e.contains("class"), "{e}");
     }
 
     #[test]

@@ -2,7 +2,9 @@
 //! 2007) and its evaluation against labelled photos. The pipeline ([`analysis`]): photo →
 //! rectification ([`segments`], [`vanishing`], [`homography`]) → floors and tiles by mutual
 //! information ([`mutual_information`], [`repetition`]) → the irreducible tile and its window
-//! ([`parse`]) → the shape grammar ([`grammar`], [`parse_grammar`]) → outputs ([`outputs`]:
+//! ([`parse`]), windows one by one ([`window_blobs`], [`window_grammar`]) → the shape
+//! grammar ([`grammar`], [`parse_grammar`]) with the library element the windows look like
+//! ([`element_library`], [`element_match`]) → outputs ([`outputs`]:
 //! overlays ([`overlay`]), rule files, 3D facades ([`facade_mesh`], [`facade_export`])). The
 //! evaluation: label maps in canonical classes ([`labels`]), window instances ([`instances`]),
 //! pixel and window-detection scores ([`score`], protocol of `facade-reconstruction.md` §4) and
@@ -10,6 +12,8 @@
 
 pub mod analysis;
 pub mod assignment;
+pub mod element_library;
+pub mod element_match;
 pub mod error;
 pub mod facade_export;
 pub mod facade_mesh;

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use image::{ImageFormat, Rgb, RgbImage};
 
 use super::analysis::Analysis;
+use super::element_library::{insert_elements, Library};
 use super::error::FacadeError;
 use super::facade_export::{appearance, write_glb_textured, write_obj_mtl};
 use super::facade_mesh::{build, check_closed, FacadeMesh, MeshParams};
@@ -159,6 +160,9 @@ pub fn write_outputs(
     std::fs::write(&rules_path, grammar.to_text()).map_err(|e| file_err(&rules_path, e))?;
     written.push(rules_path);
     let params = MeshParams::new(STOREY_M / structure.floor.max(1) as f64, (w, h));
+    let library =
+        Library::builtin().map_err(|e| file_err(Path::new("assets/facade_elements"), e))?;
+    let names = grammar.elements();
     let sizes = opts
         .widths
         .iter()
@@ -169,7 +173,9 @@ pub fn write_outputs(
         let leaves = grammar
             .derive(w * fx, h * fy)
             .map_err(|e| file_err(&obj, e))?;
-        let mesh = build(&leaves, &params).map_err(|e| file_err(&obj, e))?;
+        let mut mesh = build(&leaves, &params).map_err(|e| file_err(&obj, e))?;
+        insert_elements(&mut mesh, &leaves, &names, &library, &params)
+            .map_err(|e| file_err(&obj, e))?;
         check_closed(&mesh).map_err(|e| file_err(&obj, e))?;
         write_obj_mtl(&obj, &mesh, Some(&rect_path))?;
         let png = obj.with_extension("png");

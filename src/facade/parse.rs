@@ -592,11 +592,13 @@ mod tests {
                 scope: s(0.0, 0.0, 4.0, 4.0),
                 class: Class::Wall,
                 source: s(0.0, 0.0, 4.0, 4.0),
+                element: None,
             },
             Leaf {
                 scope: s(1.4, 1.6, 2.6, 3.0),
                 class: Class::Window,
                 source: s(1.4, 1.6, 2.6, 3.0),
+                element: None,
             },
         ];
         let p = rasterize(&leaves, 4, 4);

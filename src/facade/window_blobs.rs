@@ -36,6 +36,10 @@ pub struct BlobParams {
     /// floor (shop fronts, doors, arcades, cars), which Müller et al. also leave to rules of
     /// their own.
     pub ground: f64,
+    /// Widest gap between two panes of one window (a mullion, a transom), as a share of the
+    /// narrower pane's extent across it: side by side or stacked panes of about the same size
+    /// closer than this are merged into one window ([`merge_panes`]).
+    pub pane_gap: f64,
 }
 
 impl Default for BlobParams {
@@ -50,6 +54,7 @@ impl Default for BlobParams {
             similar: 0.5,
             border: 11.0,
             ground: 0.2,
+            pane_gap: 0.3,
         }
     }
 }
@@ -203,7 +208,7 @@ pub fn detect_windows(img: &Gray, region: &Rect, p: &BlobParams) -> Vec<Rect> {
         })
         .map(|(r, _)| r)
         .collect();
-    candidates
+    let kept = candidates
         .iter()
         .enumerate()
         .filter(|&(i, a)| {
@@ -214,6 +219,64 @@ pub fn detect_windows(img: &Gray, region: &Rect, p: &BlobParams) -> Vec<Rect> {
         })
         .map(|(_, r)| *r)
         .filter(|r| border_step(img, r) >= p.border && r.y0 + r.y1 <= 2 * ground)
+        .collect::<Vec<Rect>>();
+    merge_panes(kept, p.pane_gap)
+}
+
+/// Least overlap across the gap (share of the smaller extent) of two panes of one window.
+const PANE_ALIGN: f64 = 0.8;
+/// Greatest relative difference of the two panes' extents across the gap.
+const PANE_SIMILAR: f64 = 0.25;
+
+/// Merges panes of one window: two rectangles side by side (or one above the other) that
+/// overlap by [`PANE_ALIGN`] of the smaller one's height (width), differ in it by at most
+/// [`PANE_SIMILAR`], and are at most `gap` of the narrower one's width (height) apart become
+/// their bounding box, until no two do. Light bars cut a window's dark glass into panes;
+/// neighbouring windows stand further apart than their bars are wide.
+pub fn merge_panes(mut windows: Vec<Rect>, gap: f64) -> Vec<Rect> {
+    let joins = |a: &Rect, b: &Rect, across_x: bool| {
+        let (a0, a1, b0, b1, c0, c1, d0, d1) = if across_x {
+            (a.y0, a.y1, b.y0, b.y1, a.x0, a.x1, b.x0, b.x1)
+        } else {
+            (a.x0, a.x1, b.x0, b.x1, a.y0, a.y1, b.y0, b.y1)
+        };
+        let (ea, eb) = ((a1 - a0) as f64, (b1 - b0) as f64);
+        let overlap = a1.min(b1) as f64 - a0.max(b0) as f64;
+        let (la, lb) = ((c1 - c0) as f64, (d1 - d0) as f64);
+        // b after a along the other axis, a pixel of overlap allowed
+        let between = d0 as f64 - c1 as f64;
+        overlap >= PANE_ALIGN * ea.min(eb)
+            && (ea - eb).abs() <= PANE_SIMILAR * ea.max(eb)
+            && between >= -1.0
+            && between <= gap * la.min(lb)
+    };
+    let mut alive = vec![true; windows.len()];
+    let mut changed = true;
+    while changed {
+        changed = false;
+        for i in 0..windows.len() {
+            for j in 0..windows.len() {
+                if i == j || !alive[i] || !alive[j] {
+                    continue;
+                }
+                let (a, b) = (windows[i], windows[j]);
+                if joins(&a, &b, true) || joins(&a, &b, false) {
+                    windows[i] = Rect::new(
+                        a.x0.min(b.x0),
+                        a.y0.min(b.y0),
+                        a.x1.max(b.x1),
+                        a.y1.max(b.y1),
+                    );
+                    alive[j] = false;
+                    changed = true;
+                }
+            }
+        }
+    }
+    windows
+        .into_iter()
+        .zip(alive)
+        .filter_map(|(w, a)| a.then_some(w))
         .collect()
 }
 
@@ -303,5 +366,27 @@ mod tests {
         assert_eq!(p.len(), 2);
         assert_eq!(p[0], (Rect::new(0, 0, 1, 1), 1));
         assert_eq!(p[1], (Rect::new(1, 1, 2, 2), 1));
+    }
+
+    #[test]
+    fn the_panes_of_a_window_merge_and_neighbouring_windows_do_not() {
+        // two cross windows 24 × 33 (bars 2 px wide) whose piers are 19 px wide
+        let panes = |x: u32| {
+            [
+                Rect::new(x, 10, x + 11, 30),
+                Rect::new(x + 13, 10, x + 24, 30),
+                Rect::new(x, 32, x + 11, 43),
+                Rect::new(x + 13, 32, x + 24, 43),
+            ]
+        };
+        let all: Vec<Rect> = panes(10).into_iter().chain(panes(53)).collect();
+        let merged = merge_panes(all, 0.3);
+        assert_eq!(
+            merged,
+            vec![Rect::new(10, 10, 34, 43), Rect::new(53, 10, 77, 43)]
+        );
+        // side by side panes unlike in height stay apart (a window beside a door)
+        let unlike = vec![Rect::new(0, 0, 10, 10), Rect::new(12, 0, 22, 30)];
+        assert_eq!(merge_panes(unlike.clone(), 0.3), unlike);
     }
 }

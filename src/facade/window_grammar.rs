@@ -150,7 +150,7 @@ pub fn grammar_of_windows(windows: &[Rect], width: u32, height: u32) -> Grammar 
     let used_elsewhere = rules.values().any(|b| match b {
         Body::Split { parts, .. } => parts.iter().any(|(_, r)| *r == top),
         Body::Repeat { rule, .. } => *rule == top,
-        Body::Leaf(_) => false,
+        Body::Leaf(_) | Body::Insert { .. } => false,
     });
     if top != "Wall" && top != "Window" && !used_elsewhere {
         rules.remove(&top);

@@ -123,7 +123,21 @@ pub fn read_obj(path: &Path) -> Result<TriMesh, GeometryError> {
 /// fanned; texture coordinates and normals are ignored. Errors as [`read_obj`] (file and line);
 /// the mesh's own validity (degenerate or non-manifold faces) is left to its user.
 pub fn read_obj_surface(path: &Path) -> Result<(Vec<Vec3>, Vec<[usize; 3]>), GeometryError> {
-    let (mesh, _) = read_and_parse(path, false)?;
+    let text = fs::read_to_string(path).map_err(|source| GeometryError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    obj_surface_from_text(&text, path)
+}
+
+/// [`read_obj_surface`] of OBJ text already in memory (a built-in asset); `path` names it in
+/// errors.
+pub fn obj_surface_from_text(
+    text: &str,
+    path: &Path,
+) -> Result<(Vec<Vec3>, Vec<[usize; 3]>), GeometryError> {
+    let (mesh, _) =
+        parse(text, false).map_err(|(line, message)| parse_error(path, line, message))?;
     if mesh.triangles.is_empty() {
         return Err(parse_error(path, 0, "no faces (`f` lines)".into()));
     }

@@ -14,7 +14,7 @@ use crate::facade::analysis::{analyze, Analysis, Options, Rectify};
 use crate::facade::homography::warp_labels;
 use crate::facade::outputs::{write_outputs, OutputOptions};
 use crate::facade::parse::{rasterize, round_trip};
-use crate::facade::FacadeParse;
+use crate::facade::{Class, FacadeParse};
 
 /// An analysed photo as a script handle (shared, never copied).
 #[derive(Debug, Clone)]
@@ -149,8 +149,11 @@ when it failed), and total.",
         "structure",
         ["a: FacadeAnalysis", "Map"],
         "The parse: #{floor, tile (pixels), floors, tiles (cells of the layout), windows (the windows
-of the grammar: those found one by one, or the layout's cells holding a window), rules (the
-rule file)}; empty when the parse failed.",
+of the grammar: those found one by one, or the layout's cells holding a window), element (the
+library element recognised for the windows and inserted by the grammar, e.g. `window_cross`),
+element_score (the share of the mean window's variance its front view explains),
+element_scores (that share for every window element of the library), rules (the rule file)};
+empty when the parse failed.",
         |a: &mut FacadeAnalysis| {
             let mut m = Map::new();
             if let Ok((g, s)) = &a.0.parse {
@@ -169,6 +172,17 @@ rule file)}; empty when the parse failed.",
                     ),
                 ] {
                     m.insert(k.into(), Dynamic::from_int(v));
+                }
+                if let Some(e) = a.0.elements.iter().find(|e| e.class == Class::Window) {
+                    let score = e.scores.iter().find(|s| s.0 == e.element).map_or(0.0, |s| s.1);
+                    m.insert("element".into(), Dynamic::from(e.element.clone()));
+                    m.insert("element_score".into(), Dynamic::from_float(score));
+                    let all: Map = e
+                        .scores
+                        .iter()
+                        .map(|(n, v)| (n.as_str().into(), Dynamic::from_float(*v)))
+                        .collect();
+                    m.insert("element_scores".into(), Dynamic::from_map(all));
                 }
                 m.insert("rules".into(), Dynamic::from(g.to_text()));
             }

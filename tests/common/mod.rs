@@ -13,6 +13,19 @@ pub const WIN_X: (u32, u32) = (10, 34);
 pub const WIN_Y: (u32, u32) = (12, 45);
 
 pub fn facade(width: u32, height: u32, seed: u64) -> Gray {
+    facade_with_bars(width, height, seed, 1, &|_, _| false)
+}
+
+/// [`facade`] with every length `scale` times longer (floors, tiles, windows, frames, the
+/// tree), whose windows have light bars (mullions, transoms) where `bar(x, y)` holds, (x, y)
+/// in pixels from the window's top-left corner.
+pub fn facade_with_bars(
+    width: u32,
+    height: u32,
+    seed: u64,
+    scale: u32,
+    bar: &dyn Fn(u32, u32) -> bool,
+) -> Gray {
     let mut s = seed;
     let mut rnd = || {
         s = s
@@ -23,14 +36,18 @@ pub fn facade(width: u32, height: u32, seed: u64) -> Gray {
     let mut data = Vec::with_capacity((width * height) as usize);
     for y in 0..height {
         for x in 0..width {
-            let (tx, ty) = (x % TILE, y % FLOOR);
-            let window = (WIN_X.0..WIN_X.1).contains(&tx) && (WIN_Y.0..WIN_Y.1).contains(&ty);
+            let k = scale;
+            let (tx, ty) = (x % (k * TILE), y % (k * FLOOR));
+            let (wx, wy) = ((k * WIN_X.0, k * WIN_X.1), (k * WIN_Y.0, k * WIN_Y.1));
+            let window = (wx.0..wx.1).contains(&tx) && (wy.0..wy.1).contains(&ty);
             let frame = !window
-                && (WIN_X.0 - 2..WIN_X.1 + 2).contains(&tx)
-                && (WIN_Y.0 - 2..WIN_Y.1 + 2).contains(&ty);
+                && (wx.0 - 2 * k..wx.1 + 2 * k).contains(&tx)
+                && (wy.0 - 2 * k..wy.1 + 2 * k).contains(&ty);
             // lighter floors further up, as sun on a facade
             let light = 1.0 - 0.25 * y as f64 / height as f64;
-            let base = if window {
+            let base = if window && bar(tx - wx.0, ty - wy.0) {
+                225.0
+            } else if window {
                 55.0
             } else if frame {
                 225.0
@@ -39,7 +56,10 @@ pub fn facade(width: u32, height: u32, seed: u64) -> Gray {
             };
             let mut v = base * light + 24.0 * (rnd() - 0.5);
             // a tree in front of the lower left
-            let (dx, dy) = (x as f64 - 60.0, y as f64 - height as f64 + 40.0);
+            let (dx, dy) = (
+                (x as f64 - 60.0 * k as f64) / k as f64,
+                (y as f64 - height as f64 + 40.0 * k as f64) / k as f64,
+            );
             if dx * dx / 900.0 + dy * dy / 2500.0 < 1.0 {
                 v = 70.0 + 40.0 * rnd();
             }

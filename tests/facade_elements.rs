@@ -1,0 +1,86 @@
+//! Element recognition and insertion against ground truth: synthetic facades whose windows
+//! are drawn from a library element's front view (light bars on dark glass) must be recognised
+//! as that element, the grammar must insert it (and read back), and the facades generated at
+//! other widths must stay closed meshes with one element per window.
+
+mod common;
+
+use common::{facade, facade_with_bars, WIN_X, WIN_Y};
+use emilion::facade::element_library::{insert_elements, Library};
+use emilion::facade::element_match::recognise_elements;
+use emilion::facade::facade_mesh::{build, check_closed, MeshParams, Surface};
+use emilion::facade::grammar::Grammar;
+use emilion::facade::parse::{parse, Priors};
+use emilion::facade::Class;
+
+#[test]
+fn windows_drawn_from_each_element_are_recognised_and_inserted() {
+    let lib = Library::builtin().expect("library");
+    // twice the common facade's lengths: the panes of a cross window are then large enough
+    // to be found (17 × 19 pixels above the transom)
+    let (w, h) = (860, 684);
+    let (ww, wh) = (2 * (WIN_X.1 - WIN_X.0), 2 * (WIN_Y.1 - WIN_Y.0));
+    for name in [
+        "window_plain",
+        "window_mullion",
+        "window_cross",
+        "window_sash",
+    ] {
+        let mask = lib
+            .get(name)
+            .expect("element")
+            .front_mask(ww as usize, wh as usize);
+        let img = facade_with_bars(w, h, 5, 2, &|x, y| mask[(y * ww + x) as usize] > 0.5);
+        let (mut g, s) = parse(&img, &Priors::default()).expect("parses");
+        eprintln!(
+            "{name}: {} windows found one by one, grammar of them: {}",
+            s.windows.len(),
+            s.from_windows
+        );
+        let found = recognise_elements(&mut g, &img, &lib);
+        let window = found
+            .iter()
+            .find(|m| m.class == Class::Window)
+            .expect("windows recognised");
+        eprintln!(
+            "{name}: {:?} over {} windows",
+            window.scores, window.instances
+        );
+        assert_eq!(window.element, name, "{:?}", window.scores);
+        let text = g.to_text();
+        assert!(text.contains(&format!("insert(window, {name})")), "{text}");
+        assert_eq!(Grammar::parse(&text).expect("reads back"), g);
+        // every window of a wider facade gets its element, and the mesh stays closed
+        let leaves = g.derive(w as f64 * 1.5, h as f64).expect("derives");
+        let params = MeshParams::new(0.05, (w as f64, h as f64));
+        let mut mesh = build(&leaves, &params).expect("builds");
+        let n = insert_elements(&mut mesh, &leaves, &g.elements(), &lib, &params).expect("inserts");
+        let windows = leaves.iter().filter(|l| l.class == Class::Window).count();
+        assert_eq!(n, windows);
+        assert!(windows > 40, "{windows} windows at 1.5×");
+        check_closed(&mesh).expect("closed with its elements");
+        let group = mesh.groups.last().expect("groups");
+        assert_eq!(group.surface, Surface::Element);
+        let per = lib.get(name).expect("element").triangles.len();
+        assert_eq!(group.triangles.len(), n * per);
+    }
+}
+
+#[test]
+fn the_plain_facade_gets_plain_windows_and_an_unknown_element_is_an_error() {
+    let lib = Library::builtin().expect("library");
+    let (w, h) = (430, 342);
+    let img = facade(w, h, 9);
+    let (mut g, _) = parse(&img, &Priors::default()).expect("parses");
+    let found = recognise_elements(&mut g, &img, &lib);
+    assert_eq!(found.len(), 1, "windows only, no doors: {found:?}");
+    assert_eq!(found[0].element, "window_plain", "{:?}", found[0].scores);
+    // a rule file may name an element the library lacks: building says which
+    let text = g.to_text().replace("window_plain", "window_gothic");
+    let odd = Grammar::parse(&text).expect("syntax is fine");
+    let leaves = odd.derive(w as f64, h as f64).expect("derives");
+    let params = MeshParams::new(0.05, (w as f64, h as f64));
+    let mut mesh = build(&leaves, &params).expect("builds");
+    let e = insert_elements(&mut mesh, &leaves, &odd.elements(), &lib, &params).unwrap_err();
+    assert!(e.contains("window_gothic"), "{e}");
+}
