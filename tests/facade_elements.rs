@@ -63,6 +63,39 @@ fn windows_drawn_from_each_element_are_recognised_and_inserted() {
         assert_eq!(group.surface, Surface::Element);
         let per = lib.get(name).expect("element").triangles.len();
         assert_eq!(group.triangles.len(), n * per);
+        // each element lies in its window's recess: inside the opening, from the recess's
+        // back 6 cm towards the street
+        let (xmin, ymax) = (0.0, h as f64);
+        let openings: Vec<_> = leaves
+            .iter()
+            .filter(|l| l.class == Class::Window)
+            .map(|l| {
+                let s = params.scale;
+                (
+                    (l.scope.x0 - xmin) * s,
+                    (l.scope.x1 - xmin) * s,
+                    (ymax - l.scope.y1) * s,
+                    (ymax - l.scope.y0) * s,
+                )
+            })
+            .collect();
+        let back = -params.window_depth;
+        for t in &mesh.triangles[group.triangles.clone()] {
+            for &i in t {
+                let p = mesh.positions[i];
+                assert!(
+                    p.z >= back - 1e-12 && p.z <= back + 0.06 + 1e-12,
+                    "{name}: vertex {p:?} out of the recess"
+                );
+                assert!(
+                    openings.iter().any(|&(x0, x1, y0, y1)| {
+                        (x0 - 1e-9..=x1 + 1e-9).contains(&p.x)
+                            && (y0 - 1e-9..=y1 + 1e-9).contains(&p.y)
+                    }),
+                    "{name}: vertex {p:?} in no window"
+                );
+            }
+        }
     }
 }
 
