@@ -207,7 +207,7 @@ pub fn recognise(
         .map(|(k, e)| {
             let mask = e.front_mask(GRID, GRID);
             // the plainest element is the null model: clear inside, it is not moved
-            let shifts = if k == 0 { &SHIFTS[10..11] } else { &SHIFTS[..] };
+            let shifts: &[(isize, isize)] = if k == 0 { &[(0, 0)] } else { &SHIFTS };
             let best = shifts
                 .iter()
                 .map(|&shift| {

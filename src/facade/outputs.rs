@@ -1,7 +1,8 @@
 //! The files of one analysed photo: the diagnostic overlay (always, also when the analysis
 //! failed), the rectified photo, the parse as a LabelMeFacade-coloured label map, the rule
-//! file, and 3D facades (OBJ+MTL and glTF, textured with the rectified photo) generated from
-//! the grammar at the photo's width and at other widths.
+//! file, and 3D facades (OBJ+MTL and glTF, textured with the rectified photo, with the library
+//! elements the grammar inserts) generated from the grammar at the photo's width and at other
+//! widths.
 
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
