@@ -220,7 +220,11 @@ pub fn detect_windows(img: &Gray, region: &Rect, p: &BlobParams) -> Vec<Rect> {
         .map(|(_, r)| *r)
         .filter(|r| border_step(img, r) >= p.border && r.y0 + r.y1 <= 2 * ground)
         .collect::<Vec<Rect>>();
-    merge_panes(kept, p.pane_gap)
+    let shaped = |r: &Rect| {
+        let aspect = (r.y1 - r.y0) as f64 / (r.x1 - r.x0) as f64;
+        r.area() as f64 <= p.area.1 * area && aspect >= p.aspect.0 && aspect <= p.aspect.1
+    };
+    merge_panes(kept, p.pane_gap, shaped)
 }
 
 /// Least overlap across the gap (share of the smaller extent) of two panes of one window.
@@ -231,9 +235,10 @@ const PANE_SIMILAR: f64 = 0.25;
 /// Merges panes of one window: two rectangles side by side (or one above the other) that
 /// overlap by [`PANE_ALIGN`] of the smaller one's height (width), differ in it by at most
 /// [`PANE_SIMILAR`], and are at most `gap` of the narrower one's width (height) apart become
-/// their bounding box, until no two do. Light bars cut a window's dark glass into panes;
-/// neighbouring windows stand further apart than their bars are wide.
-pub fn merge_panes(mut windows: Vec<Rect>, gap: f64) -> Vec<Rect> {
+/// their bounding box when that is still `shaped` like a window, until no two do. Light bars
+/// cut a window's dark glass into panes; neighbouring windows stand further apart than their
+/// bars are wide, and several windows together are too large or too wide for one.
+pub fn merge_panes(mut windows: Vec<Rect>, gap: f64, shaped: impl Fn(&Rect) -> bool) -> Vec<Rect> {
     let joins = |a: &Rect, b: &Rect, across_x: bool| {
         let (a0, a1, b0, b1, c0, c1, d0, d1) = if across_x {
             (a.y0, a.y1, b.y0, b.y1, a.x0, a.x1, b.x0, b.x1)
@@ -260,13 +265,14 @@ pub fn merge_panes(mut windows: Vec<Rect>, gap: f64) -> Vec<Rect> {
                     continue;
                 }
                 let (a, b) = (windows[i], windows[j]);
-                if joins(&a, &b, true) || joins(&a, &b, false) {
-                    windows[i] = Rect::new(
-                        a.x0.min(b.x0),
-                        a.y0.min(b.y0),
-                        a.x1.max(b.x1),
-                        a.y1.max(b.y1),
-                    );
+                let union = Rect::new(
+                    a.x0.min(b.x0),
+                    a.y0.min(b.y0),
+                    a.x1.max(b.x1),
+                    a.y1.max(b.y1),
+                );
+                if (joins(&a, &b, true) || joins(&a, &b, false)) && shaped(&union) {
+                    windows[i] = union;
                     alive[j] = false;
                     changed = true;
                 }
@@ -380,13 +386,22 @@ mod tests {
             ]
         };
         let all: Vec<Rect> = panes(10).into_iter().chain(panes(53)).collect();
-        let merged = merge_panes(all, 0.3);
+        let merged = merge_panes(all, 0.3, |_| true);
         assert_eq!(
             merged,
             vec![Rect::new(10, 10, 34, 43), Rect::new(53, 10, 77, 43)]
         );
         // side by side panes unlike in height stay apart (a window beside a door)
         let unlike = vec![Rect::new(0, 0, 10, 10), Rect::new(12, 0, 22, 30)];
-        assert_eq!(merge_panes(unlike.clone(), 0.3), unlike);
+        assert_eq!(merge_panes(unlike.clone(), 0.3, |_| true), unlike);
+        // windows of a row close together (narrow piers) merge only while the union still has
+        // a window's shape
+        let row = vec![Rect::new(0, 0, 24, 33), Rect::new(29, 0, 53, 33)];
+        assert_eq!(
+            merge_panes(row.clone(), 0.3, |_| true),
+            vec![Rect::new(0, 0, 53, 33)]
+        );
+        let narrow = |r: &Rect| r.x1 - r.x0 <= 40;
+        assert_eq!(merge_panes(row.clone(), 0.3, narrow), row);
     }
 }
