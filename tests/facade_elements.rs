@@ -117,3 +117,45 @@ fn the_plain_facade_gets_plain_windows_and_an_unknown_element_is_an_error() {
     let e = insert_elements(&mut mesh, &leaves, &odd.elements(), &lib, &params).unwrap_err();
     assert!(e.contains("window_gothic"), "{e}");
 }
+
+#[test]
+fn a_hand_written_rule_file_builds_closed_facades_with_its_elements() {
+    let lib = Library::builtin().expect("library");
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/townhouse.cga"),
+    )
+    .expect("the example rule file");
+    let g = Grammar::parse(&text).expect("parses");
+    assert_eq!(g.size, (800.0, 1000.0));
+    let params = MeshParams::new(0.01, g.size);
+    let names = g.elements();
+    let count = |leaves: &[emilion::facade::grammar::Leaf], element: &str| {
+        let k = names.iter().position(|n| n == element);
+        leaves.iter().filter(|l| l.element == k).count()
+    };
+    // 1000 − 60 − 340 = 600: two floors of 300; 800 − 100 = 700: four bays of 175, and at 2×
+    // (1600 − 100) / 175 = 8.6: nine bays; the ground floor keeps one door and two windows
+    for (factor, bays) in [(1.0, 4), (2.0, 9)] {
+        let leaves = g.derive(800.0 * factor, 1000.0).expect("derives");
+        assert_eq!(count(&leaves, "window_cross"), 2 * bays);
+        assert_eq!(count(&leaves, "window_sash"), 2);
+        assert_eq!(count(&leaves, "door_panel"), 1);
+        let mut mesh = build(&leaves, &params).expect("builds");
+        let n = insert_elements(&mut mesh, &leaves, &names, &lib, &params).expect("inserts");
+        assert_eq!(n, 2 * bays + 3);
+        check_closed(&mesh).expect("closed");
+        // the door stands on the ground: its element reaches the facade's bottom edge
+        let tris = |name: &str| lib.get(name).expect("element").triangles.len();
+        let group = mesh.groups.last().expect("elements");
+        assert_eq!(
+            group.triangles.len(),
+            2 * bays * tris("window_cross") + 2 * tris("window_sash") + tris("door_panel")
+        );
+        let lowest = mesh.triangles[group.triangles.clone()]
+            .iter()
+            .flatten()
+            .map(|&i| mesh.positions[i].y)
+            .fold(f64::INFINITY, f64::min);
+        assert!(lowest.abs() < 1e-12, "door element starts at {lowest} m");
+    }
+}

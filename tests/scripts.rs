@@ -179,6 +179,40 @@ fn negative_density_is_named() {
 }
 
 #[test]
+fn a_bad_rule_file_is_named_with_its_line() {
+    let dir = temp_dir("bad_rules_file");
+    let rules = dir.join("bad.cga");
+    std::fs::write(
+        &rules,
+        "// axiom F size 10 10\nF --> split(z) { 1: W }\nW --> wall\n",
+    )
+    .unwrap();
+    let p = write_script(
+        "bad_rules",
+        &format!(
+            "let f = facade_from_rules(\"{}\", \"{}\", \"x\", #{{}});\n",
+            rules.display(),
+            dir.display()
+        ),
+    );
+    let text = run_file(&p, &[])
+        .expect_err("a bad direction must fail")
+        .to_string();
+    assert!(
+        text.contains("bad.cga") && text.contains("line 2"),
+        "{text}"
+    );
+    let p = write_script(
+        "bad_rules_option",
+        "let f = facade_from_rules(\"scripts/townhouse.cga\", \"out\", \"x\", #{ scale: -1.0 });\n",
+    );
+    let text = run_file(&p, &[])
+        .expect_err("a negative scale must fail")
+        .to_string();
+    assert!(text.contains("scale"), "{text}");
+}
+
+#[test]
 fn buckling_parameters_are_checked() {
     for (name, src, what) in [
         (

@@ -14,6 +14,7 @@ use super::element_library::{insert_elements, Library};
 use super::error::FacadeError;
 use super::facade_export::{appearance, write_glb_textured, write_obj_mtl};
 use super::facade_mesh::{build, check_closed, FacadeMesh, MeshParams};
+use super::grammar::Grammar;
 use super::labels::{Class, LabelMap};
 use super::overlay;
 use super::parse::rasterize;
@@ -161,6 +162,32 @@ pub fn write_outputs(
     std::fs::write(&rules_path, grammar.to_text()).map_err(|e| file_err(&rules_path, e))?;
     written.push(rules_path);
     let params = MeshParams::new(STOREY_M / structure.floor.max(1) as f64, (w, h));
+    written.extend(write_generated(
+        grammar,
+        &params,
+        Some(&rect_path),
+        dir,
+        stem,
+        opts,
+    )?);
+    Ok(written)
+}
+
+/// Writes the 3D facades that `grammar` generates, per width and height factor of its parsed
+/// size (`opts`): `STEM_wX.obj/.mtl/.glb` (`STEM_hX…` for heights) with the library elements
+/// its rules insert, textured with `texture` (the photo its sources refer to, of
+/// `params.texture_size`) when given, and a render `STEM_wX.png`. Each mesh is checked to be
+/// closed before it is written. Returns the files written.
+pub fn write_generated(
+    grammar: &Grammar,
+    params: &MeshParams,
+    texture: Option<&Path>,
+    dir: &Path,
+    stem: &str,
+    opts: &OutputOptions,
+) -> Result<Vec<PathBuf>, FacadeError> {
+    let mut written = Vec::new();
+    let (w, h) = grammar.size;
     let library =
         Library::builtin().map_err(|e| file_err(Path::new("assets/facade_elements"), e))?;
     let names = grammar.elements();
@@ -174,16 +201,16 @@ pub fn write_outputs(
         let leaves = grammar
             .derive(w * fx, h * fy)
             .map_err(|e| file_err(&obj, e))?;
-        let mut mesh = build(&leaves, &params).map_err(|e| file_err(&obj, e))?;
-        insert_elements(&mut mesh, &leaves, &names, &library, &params)
+        let mut mesh = build(&leaves, params).map_err(|e| file_err(&obj, e))?;
+        insert_elements(&mut mesh, &leaves, &names, &library, params)
             .map_err(|e| file_err(&obj, e))?;
         check_closed(&mesh).map_err(|e| file_err(&obj, e))?;
-        write_obj_mtl(&obj, &mesh, Some(&rect_path))?;
+        write_obj_mtl(&obj, &mesh, texture)?;
         let png = obj.with_extension("png");
         render_facade(&png, &mesh)?;
         written.push(png);
         let glb = obj.with_extension("glb");
-        write_glb_textured(&glb, &mesh, Some(&rect_path))?;
+        write_glb_textured(&glb, &mesh, texture)?;
         written.push(obj.with_extension("mtl"));
         written.push(obj);
         written.push(glb);

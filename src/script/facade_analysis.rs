@@ -11,8 +11,10 @@ use super::convert::{finite, rt_err, RResult};
 use super::facade::Labels;
 use super::{getter, register};
 use crate::facade::analysis::{analyze, Analysis, Options, Rectify};
+use crate::facade::facade_mesh::MeshParams;
+use crate::facade::grammar::Grammar;
 use crate::facade::homography::warp_labels;
-use crate::facade::outputs::{write_outputs, OutputOptions};
+use crate::facade::outputs::{write_generated, write_outputs, OutputOptions};
 use crate::facade::parse::{rasterize, round_trip};
 use crate::facade::{Class, FacadeParse};
 
@@ -85,6 +87,75 @@ fn fractions_free(d: &Dynamic, what: &str) -> RResult<(f64, f64)> {
         return Err(rt_err(format!("each of `{what}` must be a point [x, y]")));
     }
     Ok((finite(&arr[0], what)?, finite(&arr[1], what)?))
+}
+
+/// Positive finite factors from a script array.
+fn factors(d: &Dynamic, what: &str) -> RResult<Vec<f64>> {
+    let arr = d
+        .read_lock::<Array>()
+        .ok_or_else(|| rt_err(format!("`{what}` must be an array of numbers")))?;
+    arr.iter()
+        .map(|v| {
+            let f = finite(v, what)?;
+            if f > 0.0 {
+                Ok(f)
+            } else {
+                Err(rt_err(format!("`{what}` factors must be > 0, got {f}")))
+            }
+        })
+        .collect()
+}
+
+/// Reads the rule file at `rules` and writes the facades it generates (see
+/// `facade_from_rules`).
+fn from_rules(rules: &str, out: &str, stem: &str, m: &Map) -> RResult<Array> {
+    let (mut scale, mut texture) = (0.01, None::<String>);
+    let mut opts = OutputOptions {
+        widths: vec![1.0],
+        heights: vec![],
+    };
+    for (k, v) in m {
+        match k.as_str() {
+            "scale" => {
+                scale = finite(v, "scale")?;
+                if scale <= 0.0 {
+                    return Err(rt_err(format!(
+                        "`scale` must be > 0 m per unit, got {scale}"
+                    )));
+                }
+            }
+            "texture" => {
+                texture = Some(
+                    v.clone()
+                        .into_string()
+                        .map_err(|_| rt_err("`texture` must be the path of a PNG"))?,
+                )
+            }
+            "widths" => opts.widths = factors(v, "widths")?,
+            "heights" => opts.heights = factors(v, "heights")?,
+            other => {
+                return Err(rt_err(format!(
+                    "unknown option `{other}` (known: scale, texture, widths, heights)"
+                )))
+            }
+        }
+    }
+    let text = std::fs::read_to_string(rules).map_err(|e| rt_err(format!("{rules}: {e}")))?;
+    let grammar = Grammar::parse(&text).map_err(|e| rt_err(format!("{rules}: {e}")))?;
+    let params = MeshParams::new(scale, grammar.size);
+    let files = write_generated(
+        &grammar,
+        &params,
+        texture.as_deref().map(Path::new),
+        Path::new(out),
+        stem,
+        &opts,
+    )
+    .map_err(|e| rt_err(e.to_string()))?;
+    Ok(files
+        .into_iter()
+        .map(|p| Dynamic::from(p.display().to_string()))
+        .collect())
 }
 
 fn run(path: &str, o: &Options) -> RResult<FacadeAnalysis> {
@@ -240,6 +311,26 @@ agrees with the parse (1 = lossless); 0 when the parse failed.",
                 Ok((g, _)) => round_trip(g, a.0.gray.width, a.0.gray.height).map_err(rt_err),
                 Err(_) => Ok(0.0),
             }
+        }
+    );
+    register!(
+        engine,
+        "facade_from_rules",
+        [
+            "rules: String",
+            "out: String",
+            "stem: String",
+            "options: Map",
+            "Array"
+        ],
+        "Reads a rule file (as `write_facade_outputs` writes them, or written by hand: `split`,
+`repeat`, class leaves and `insert(window, window_cross)` of the element library) and writes
+the 3D facades it generates at its own size times each factor: out/STEM_w1.obj/.mtl/.glb and a
+render STEM_w1.png, … Options: #{scale (metres per facade unit, 0.01), texture (the PNG its
+sizes refer to, none by default), widths ([1.0]), heights ([])}. Errors name the file and line.
+Returns the paths.",
+        |rules: &str, out: &str, stem: &str, options: Map| -> RResult<Array> {
+            from_rules(rules, out, stem, &options)
         }
     );
     register!(
