@@ -52,19 +52,12 @@ pub fn normalised_instance(img: &Gray, r: &Rect) -> Option<Vec<f64>> {
         return None;
     }
     let (w, h) = ((x1 - r.x0) as f64, (y1 - r.y0) as f64);
-    let px = |x: usize, y: usize| img.at(x as u32, y as u32) as f64;
     let mut v = Vec::with_capacity(GRID * GRID);
     for j in 0..GRID {
-        let y = (r.y0 as f64 + (j as f64 + 0.5) / GRID as f64 * h - 0.5).max(0.0);
-        let (ya, fy) = (y.floor() as usize, y.fract());
-        let yb = (ya + 1).min(y1 as usize - 1);
+        let y = r.y0 as f64 + (j as f64 + 0.5) / GRID as f64 * h - 0.5;
         for i in 0..GRID {
-            let x = (r.x0 as f64 + (i as f64 + 0.5) / GRID as f64 * w - 0.5).max(0.0);
-            let (xa, fx) = (x.floor() as usize, x.fract());
-            let xb = (xa + 1).min(x1 as usize - 1);
-            let top = px(xa, ya) * (1.0 - fx) + px(xb, ya) * fx;
-            let bottom = px(xa, yb) * (1.0 - fx) + px(xb, yb) * fx;
-            v.push(top * (1.0 - fy) + bottom * fy);
+            let x = r.x0 as f64 + (i as f64 + 0.5) / GRID as f64 * w - 0.5;
+            v.push(img.bilinear(x, y)?);
         }
     }
     standardise(&mut v).then_some(v)

@@ -43,6 +43,26 @@ impl Gray {
     pub fn at(&self, x: u32, y: u32) -> u8 {
         self.data[y as usize * self.width as usize + x as usize]
     }
+
+    /// Bilinear sample at continuous pixel index (u, v) (pixel k's centre at k), `None`
+    /// outside.
+    pub fn bilinear(&self, u: f64, v: f64) -> Option<f64> {
+        let (w, h) = (self.width as f64, self.height as f64);
+        if !(u >= -0.5 && v >= -0.5 && u <= w - 0.5 && v <= h - 0.5) {
+            return None;
+        }
+        let (u, v) = (u.clamp(0.0, w - 1.0), v.clamp(0.0, h - 1.0));
+        let (x0, y0) = (u.floor() as u32, v.floor() as u32);
+        let (x1, y1) = ((x0 + 1).min(self.width - 1), (y0 + 1).min(self.height - 1));
+        let (fx, fy) = (u - x0 as f64, v - y0 as f64);
+        let p = |x, y| self.at(x, y) as f64;
+        Some(
+            p(x0, y0) * (1.0 - fx) * (1.0 - fy)
+                + p(x1, y0) * fx * (1.0 - fy)
+                + p(x0, y1) * (1.0 - fx) * fy
+                + p(x1, y1) * fx * fy,
+        )
+    }
 }
 
 /// Reads an image file (JPEG or PNG) as 8-bit RGB, errors naming the file.

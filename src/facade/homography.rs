@@ -135,7 +135,7 @@ pub fn warp_gray(src: &Gray, h: &Homography, width: u32, height: u32) -> Option<
         for x in 0..width {
             let v = inv
                 .apply([x as f64 + 0.5, y as f64 + 0.5])
-                .and_then(|[u, v]| bilinear(src, u - 0.5, v - 0.5))
+                .and_then(|[u, v]| src.bilinear(u - 0.5, v - 0.5))
                 .unwrap_or(0.0);
             data.push(v.round().clamp(0.0, 255.0) as u8);
         }
@@ -196,25 +196,6 @@ pub fn warp_labels(src: &LabelMap, h: &Homography, width: u32, height: u32) -> O
         }
     }
     Some(out)
-}
-
-/// Bilinear sample at continuous pixel index (u, v) (pixel k's centre at k), `None` outside.
-fn bilinear(img: &Gray, u: f64, v: f64) -> Option<f64> {
-    let (w, h) = (img.width as f64, img.height as f64);
-    if !(u >= -0.5 && v >= -0.5 && u <= w - 0.5 && v <= h - 0.5) {
-        return None;
-    }
-    let (u, v) = (u.clamp(0.0, w - 1.0), v.clamp(0.0, h - 1.0));
-    let (x0, y0) = (u.floor() as u32, v.floor() as u32);
-    let (x1, y1) = ((x0 + 1).min(img.width - 1), (y0 + 1).min(img.height - 1));
-    let (fx, fy) = (u - x0 as f64, v - y0 as f64);
-    let p = |x, y| img.at(x, y) as f64;
-    Some(
-        p(x0, y0) * (1.0 - fx) * (1.0 - fy)
-            + p(x1, y0) * fx * (1.0 - fy)
-            + p(x0, y1) * (1.0 - fx) * fy
-            + p(x1, y1) * fx * fy,
-    )
 }
 
 #[cfg(test)]
