@@ -1,7 +1,8 @@
 //! Element recognition and insertion against ground truth: synthetic facades whose windows
 //! are drawn from a library element's front view (light bars on dark glass) must be recognised
 //! as that element, the grammar must insert it (and read back), and the facades generated at
-//! other widths must stay closed meshes with one element per window.
+//! other widths must stay closed meshes with one element per window. The synthetic facades'
+//! frames (2 px at scale 1) are found by tile refinement and built as casing.
 
 mod common;
 
@@ -11,6 +12,7 @@ use emilion::facade::element_match::recognise_elements;
 use emilion::facade::facade_mesh::{build, check_closed, MeshParams, Surface};
 use emilion::facade::grammar::Grammar;
 use emilion::facade::parse::{parse, Priors};
+use emilion::facade::tile_refinement::Refinement;
 use emilion::facade::Class;
 
 #[test]
@@ -37,6 +39,14 @@ fn windows_drawn_from_each_element_are_recognised_and_inserted() {
             s.windows.len(),
             s.from_windows
         );
+        // the common facade draws a light frame 2 px wide (here 4) round each window; the
+        // element's own frame (a light ring 0.07 of the window wide) joins it
+        eprintln!("{name}: {:?}", s.refinement);
+        assert!(
+            (4..=8).contains(&s.refinement.frame),
+            "{name}: {:?}",
+            s.refinement
+        );
         let found = recognise_elements(&mut g, &img, &lib);
         let window = found
             .iter()
@@ -56,43 +66,56 @@ fn windows_drawn_from_each_element_are_recognised_and_inserted() {
         let mut mesh = build(&leaves, &params).expect("builds");
         let n = insert_elements(&mut mesh, &leaves, &g.elements(), &lib, &params).expect("inserts");
         let windows = leaves.iter().filter(|l| l.class == Class::Window).count();
-        assert_eq!(n, windows);
+        // each window, the four strips of its frame and its sill if one was found
+        let frames: Vec<_> = leaves
+            .iter()
+            .filter(|l| l.class == Class::Wall && l.element.is_some())
+            .collect();
+        let sill = usize::from(s.refinement.sill > 0);
+        assert_eq!(frames.len(), (4 + sill) * windows);
+        assert_eq!(n, windows + frames.len());
         assert!(windows > 40, "{windows} windows at 1.5×");
         check_closed(&mesh).expect("closed with its elements");
         let group = mesh.groups.last().expect("groups");
         assert_eq!(group.surface, Surface::Element);
         let per = lib.get(name).expect("element").triangles.len();
-        assert_eq!(group.triangles.len(), n * per);
+        let strip = lib.get("wall_frame").expect("casing").triangles.len();
+        assert_eq!(strip, lib.get("wall_sill").expect("sill").triangles.len());
+        assert_eq!(group.triangles.len(), windows * per + frames.len() * strip);
         // each element lies in its window's recess: inside the opening, from the recess's
-        // back 6 cm towards the street
+        // back 6 cm towards the street; or on a strip of frame or a sill, standing out of the
+        // wall (3 and 6 cm)
         let (xmin, ymax) = (0.0, h as f64);
-        let openings: Vec<_> = leaves
-            .iter()
-            .filter(|l| l.class == Class::Window)
-            .map(|l| {
-                let s = params.scale;
-                (
-                    (l.scope.x0 - xmin) * s,
-                    (l.scope.x1 - xmin) * s,
-                    (ymax - l.scope.y1) * s,
-                    (ymax - l.scope.y0) * s,
-                )
+        let scopes = |class: Class| -> Vec<(f64, f64, f64, f64)> {
+            leaves
+                .iter()
+                .filter(|l| l.class == class && l.element.is_some())
+                .map(|l| {
+                    let s = params.scale;
+                    (
+                        (l.scope.x0 - xmin) * s,
+                        (l.scope.x1 - xmin) * s,
+                        (ymax - l.scope.y1) * s,
+                        (ymax - l.scope.y0) * s,
+                    )
+                })
+                .collect()
+        };
+        let (openings, strips) = (scopes(Class::Window), scopes(Class::Wall));
+        let within = |rects: &[(f64, f64, f64, f64)], p: &emilion::geometry::Vec3| {
+            rects.iter().any(|&(x0, x1, y0, y1)| {
+                (x0 - 1e-9..=x1 + 1e-9).contains(&p.x) && (y0 - 1e-9..=y1 + 1e-9).contains(&p.y)
             })
-            .collect();
+        };
         let back = -params.window_depth;
         for t in &mesh.triangles[group.triangles.clone()] {
             for &i in t {
                 let p = mesh.positions[i];
+                let in_recess = p.z >= back - 1e-12 && p.z <= back + 0.06 + 1e-12;
+                let on_wall = p.z >= -1e-12 && p.z <= 0.06 + 1e-12;
                 assert!(
-                    p.z >= back - 1e-12 && p.z <= back + 0.06 + 1e-12,
-                    "{name}: vertex {p:?} out of the recess"
-                );
-                assert!(
-                    openings.iter().any(|&(x0, x1, y0, y1)| {
-                        (x0 - 1e-9..=x1 + 1e-9).contains(&p.x)
-                            && (y0 - 1e-9..=y1 + 1e-9).contains(&p.y)
-                    }),
-                    "{name}: vertex {p:?} in no window"
+                    (in_recess && within(&openings, &p)) || (on_wall && within(&strips, &p)),
+                    "{name}: vertex {p:?} neither in a window's recess nor on its frame"
                 );
             }
         }
@@ -104,7 +127,17 @@ fn the_plain_facade_gets_plain_windows_and_an_unknown_element_is_an_error() {
     let lib = Library::builtin().expect("library");
     let (w, h) = (430, 342);
     let img = facade(w, h, 9);
-    let (mut g, _) = parse(&img, &Priors::default()).expect("parses");
+    let (mut g, s) = parse(&img, &Priors::default()).expect("parses");
+    // tile refinement: the frame the common facade draws (2 px), no sill, and the layout's
+    // windows already on their edges
+    assert_eq!(
+        s.refinement,
+        Refinement {
+            sides: [0; 4],
+            frame: 2,
+            sill: 0
+        }
+    );
     let found = recognise_elements(&mut g, &img, &lib);
     assert_eq!(found.len(), 1, "windows only, no doors: {found:?}");
     assert_eq!(found[0].element, "window_plain", "{:?}", found[0].scores);

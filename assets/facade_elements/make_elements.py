@@ -26,6 +26,10 @@ els={
  'window_cross':("a window frame with a mullion and a transom at 0.65 of its height (French cross window)",ring+cross),
  'window_sash':("a window frame with a horizontal meeting rail at half height (sash window)",ring+sash),
  'door_panel':("a door frame (sides and head) with two raised panels",door),
+ # wall mouldings: a leaf of wall that tile refinement found round a window (its casing) or
+ # below it (its sill) carries one of these, standing out of the wall's front
+ 'wall_frame':("a strip of window casing standing 3 cm out of the wall",[(0,0,1,1,0,0.03)]),
+ 'wall_sill':("a window sill standing 6 cm out of the wall",[(0,0,1,1,0,0.06)]),
 }
 for n,(d,b) in els.items():
     open(n+".obj","w").write(boxes_obj(n,d,b))

@@ -14,7 +14,7 @@ use crate::geometry::obj::obj_surface_from_text;
 use crate::geometry::Vec3;
 
 /// The built-in elements: (name, OBJ text).
-const BUILTIN: [(&str, &str); 5] = [
+const BUILTIN: [(&str, &str); 7] = [
     (
         "window_plain",
         include_str!("../../assets/facade_elements/window_plain.obj"),
@@ -35,6 +35,14 @@ const BUILTIN: [(&str, &str); 5] = [
         "door_panel",
         include_str!("../../assets/facade_elements/door_panel.obj"),
     ),
+    (
+        "wall_frame",
+        include_str!("../../assets/facade_elements/wall_frame.obj"),
+    ),
+    (
+        "wall_sill",
+        include_str!("../../assets/facade_elements/wall_sill.obj"),
+    ),
 ];
 
 /// How far (in units of the opening) an element may reach outside its unit square.
@@ -44,7 +52,8 @@ const SLACK: f64 = 1e-9;
 /// metres from the back of the opening, towards the street.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Element {
-    /// Name (`window_cross`); its prefix before `_` is the class it is for.
+    /// Name (`window_cross`); its prefix before `_` is the class it is for (`wall_` for the
+    /// mouldings tile refinement puts round and below windows).
     pub name: String,
     /// The class it is inserted in.
     pub class: Class,
@@ -64,9 +73,16 @@ impl Element {
             obj_surface_from_text(text, Path::new(&file)).map_err(|e| e.to_string())?;
         let prefix = name.split('_').next().unwrap_or("");
         let class = Class::from_name(prefix)
-            .filter(|c| matches!(c, Class::Window | Class::Door | Class::Balcony))
+            .filter(|c| {
+                matches!(
+                    c,
+                    Class::Window | Class::Door | Class::Balcony | Class::Wall
+                )
+            })
             .ok_or_else(|| {
-                format!("element {file}: the name must start with window_, door_ or balcony_")
+                format!(
+                    "element {file}: the name must start with window_, door_, balcony_ or wall_"
+                )
             })?;
         let inside = |v: f64| (-SLACK..=1.0 + SLACK).contains(&v);
         if let Some(i) = positions
@@ -216,6 +232,7 @@ mod tests {
         let lib = Library::builtin().expect("built-in elements");
         assert_eq!(lib.of_class(Class::Window).count(), 4);
         assert_eq!(lib.of_class(Class::Door).count(), 1);
+        assert_eq!(lib.of_class(Class::Wall).count(), 2);
         let (w, h) = (20, 20);
         let at = |m: &[f64], x: usize, y: usize| m[y * w + x];
         let plain = lib.get("window_plain").expect("plain").front_mask(w, h);

@@ -2,7 +2,8 @@
 //! 2007) and its evaluation against labelled photos. The pipeline ([`analysis`]): photo →
 //! rectification ([`segments`], [`vanishing`], [`homography`]) → floors and tiles by mutual
 //! information ([`mutual_information`], [`repetition`]) → the irreducible tile and its window
-//! ([`parse`]), windows one by one ([`window_blobs`], [`window_grammar`]) → the shape
+//! ([`parse`]), windows one by one ([`window_blobs`], [`window_grammar`]) → their frames and
+//! sills ([`tile_refinement`]) → the shape
 //! grammar ([`grammar`], [`parse_grammar`]) with the library element the windows look like
 //! ([`element_library`], [`element_match`]) → outputs ([`outputs`]:
 //! overlays ([`overlay`]), rule files, 3D facades ([`facade_mesh`], [`facade_export`])). The
@@ -33,6 +34,7 @@ pub mod report;
 pub mod score;
 pub mod segments;
 pub mod structure;
+pub mod tile_refinement;
 pub mod vanishing;
 pub mod window_blobs;
 pub mod window_grammar;

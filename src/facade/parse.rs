@@ -14,6 +14,7 @@ use super::rect::Rect;
 use super::repetition::{detect, Axis};
 use super::report::FacadeParse;
 use super::score::PixelScore;
+use super::tile_refinement::{measure, Refinement};
 use super::window_blobs::{detect_windows, BlobParams};
 use super::window_grammar::grammar_of_windows;
 
@@ -74,8 +75,10 @@ pub struct Structure {
     /// layout's windows agree with them less than [`GRID_AGREEMENT`]; otherwise the grammar
     /// is the layout's (floors and tiles that repeat).
     pub from_windows: bool,
+    /// The frame and sill round the grammar's windows ([`super::tile_refinement`]).
+    pub refinement: Refinement,
     /// Seconds spent in: floor search, tile search, irreducible tile, window (the layout's,
-    /// with synchronisation), windows one by one (with the choice of grammar).
+    /// with synchronisation), windows one by one (with the choice of grammar and tile refinement).
     pub seconds: [f64; 5],
 }
 
@@ -196,6 +199,7 @@ pub fn parse_region(
         irreducible: tile,
         windows,
         from_windows: false,
+        refinement: Refinement::default(),
         seconds: [
             (t1 - t0).as_secs_f64(),
             (t2 - t1).as_secs_f64(),
@@ -204,14 +208,27 @@ pub fn parse_region(
             0.0,
         ],
     };
-    let grid = grammar_of(&structure, full.width, full.height);
-    let grammar = if structure.windows.is_empty()
-        || window_agreement(&grid, &structure.windows, full.width, full.height) >= GRID_AGREEMENT
-    {
-        grid
+    let none = Refinement::default();
+    let grid = grammar_of(&structure, full.width, full.height, none);
+    structure.from_windows = !structure.windows.is_empty()
+        && window_agreement(&grid, &structure.windows, full.width, full.height) < GRID_AGREEMENT;
+    // tile refinement: the frame and sill round the chosen grammar's windows
+    let windows = if structure.from_windows {
+        structure.windows.clone()
     } else {
-        structure.from_windows = true;
-        grammar_of_windows(&structure.windows, full.width, full.height)
+        let leaves = grid.derive(full.width as f64, full.height as f64)?;
+        rasterize(&leaves, full.width, full.height).windows
+    };
+    structure.refinement = measure(full, &windows, !structure.from_windows);
+    let grammar = if structure.from_windows {
+        grammar_of_windows(
+            &structure.windows,
+            full.width,
+            full.height,
+            structure.refinement,
+        )
+    } else {
+        grammar_of(&structure, full.width, full.height, structure.refinement)
     };
     structure.seconds[4] = t4.elapsed().as_secs_f64();
     Ok((grammar, structure))

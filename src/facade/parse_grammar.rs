@@ -9,6 +9,8 @@ use std::collections::BTreeMap;
 use super::grammar::{Body, Dir, Grammar, Size};
 use super::labels::Class;
 use super::parse::Structure;
+use super::rect::Rect;
+use super::tile_refinement::{framed_window, Refinement};
 
 /// A rule name for `key` among the variants seen so far: `base` for the first, `base2`, … for
 /// the others.
@@ -27,8 +29,10 @@ fn variant<K: PartialEq>(seen: &mut Vec<K>, key: K, base: &str) -> String {
     }
 }
 
-/// The grammar of a parse. Facade units are the photo's pixels.
-pub fn grammar_of(s: &Structure, width: u32, height: u32) -> Grammar {
+/// The grammar of a parse. Facade units are the photo's pixels. The window's sides move as
+/// `refinement` says and it gets its frame and sill when they fit in every cell with wall to
+/// spare; else it goes without them.
+pub fn grammar_of(s: &Structure, width: u32, height: u32, refinement: Refinement) -> Grammar {
     let (w, h) = (width as f64, height as f64);
     let (fh, tw) = (s.floor as f64, s.tile as f64);
     let (nf, nt) = s.count;
@@ -51,10 +55,26 @@ pub fn grammar_of(s: &Structure, width: u32, height: u32) -> Grammar {
         return done(rules);
     }
     let split = |dir: Dir, parts: Vec<(Size, String)>| Body::Split { dir, parts };
-    let win = s.window;
-    let (win_w, win_h) = ((win.x1 - win.x0) as f64, (win.y1 - win.y0) as f64);
     let heights: Vec<f64> = rs.windows(2).map(|p| p[1] - p[0]).collect();
     let widths: Vec<f64> = cs.windows(2).map(|p| p[1] - p[0]).collect();
+    let fits = |u: Rect| {
+        u.x0 > 0
+            && u.y0 > 0
+            && widths.iter().all(|&wj| (u.x1 as f64) < wj)
+            && heights.iter().all(|&hi| (u.y1 as f64) < hi)
+    };
+    // the moved window with its frame and sill if they fit, else without, else as found
+    let refinement = [refinement, refinement.bare(), Refinement::default()]
+        .into_iter()
+        .find(|r| {
+            let w = r.window(&s.window);
+            w.x0 >= r.frame && w.y0 >= r.frame && fits(r.unit(&w))
+        })
+        .unwrap_or_default();
+    let bare = refinement.window(&s.window);
+    // the window with its frame and sill, and its rule
+    let win = refinement.unit(&bare);
+    let (win_w, win_h) = ((win.x1 - win.x0) as f64, (win.y1 - win.y0) as f64);
     let uniform_w = widths.iter().all(|&x| x == tw);
     rules.insert(
         "Facade".to_string(),
@@ -68,6 +88,12 @@ pub fn grammar_of(s: &Structure, width: u32, height: u32) -> Grammar {
         ),
     );
     rules.insert("Window".to_string(), Body::Leaf(Class::Window));
+    let unit = framed_window(
+        &mut rules,
+        refinement,
+        (bare.x1 - bare.x0) as f64,
+        (bare.y1 - bare.y0) as f64,
+    );
     // one window-cell rule per distinct cell width: wall, the window, wall
     let mut tiles_seen: Vec<u64> = Vec::new();
     let tile_names: Vec<String> = widths
@@ -79,7 +105,7 @@ pub fn grammar_of(s: &Structure, width: u32, height: u32) -> Grammar {
                     Dir::X,
                     vec![
                         (Size::Floating(win.x0 as f64), "Wall".into()),
-                        (Size::Fixed(win_w), "Window".into()),
+                        (Size::Fixed(win_w), unit.clone()),
                         (Size::Floating(wj - win.x1 as f64), "Wall".into()),
                     ],
                 )

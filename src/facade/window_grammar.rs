@@ -12,6 +12,7 @@ use std::collections::BTreeMap;
 use super::grammar::{Body, Dir, Grammar, Size};
 use super::labels::Class;
 use super::rect::Rect;
+use super::tile_refinement::{framed_window, named, Refinement};
 
 /// The extent of `r` along `dir`.
 fn span(r: &Rect, dir: Dir) -> (u32, u32) {
@@ -40,21 +41,6 @@ fn groups(windows: &[Rect], dir: Dir) -> Vec<((u32, u32), Vec<Rect>)> {
     out
 }
 
-/// The name of `body` among the rules made so far (`base1`, `base2`, … by first use), adding
-/// it when new.
-fn named(rules: &mut BTreeMap<String, Body>, body: Body, base: &str) -> String {
-    if let Some((n, _)) = rules
-        .iter()
-        .find(|(n, b)| **b == body && n.starts_with(base))
-    {
-        return n.clone();
-    }
-    let k = rules.keys().filter(|n| n.starts_with(base)).count() + 1;
-    let n = format!("{base}{k}");
-    rules.insert(n.clone(), body);
-    n
-}
-
 /// A split along `dir` of `[a, b)` into floating wall and fixed parts at `items` (start, end,
 /// rule), zero-length walls left out.
 fn split_between(dir: Dir, a: u32, b: u32, items: &[(u32, u32, String)]) -> Body {
@@ -73,14 +59,20 @@ fn split_between(dir: Dir, a: u32, b: u32, items: &[(u32, u32, String)]) -> Body
     Body::Split { dir, parts }
 }
 
-/// The rule for `scope` holding `windows` (each inside it): wall, the window filling it, or
-/// a cut across the scope between windows: rows first, then columns (recursive XY cut). When
-/// no cut separates them (windows that overlap, or four that wind round each other), the
-/// smallest is dropped.
-fn rule_of(rules: &mut BTreeMap<String, Body>, scope: Rect, windows: &[Rect]) -> String {
+/// The rule for `scope` holding `windows` (each inside it; a window here is the unit of a
+/// window with its frame and sill, and `leaf` gives the rule of a unit): wall, the unit
+/// filling it, or a cut across the scope between windows: rows first, then columns
+/// (recursive XY cut). When no cut separates them (windows that overlap, or four that wind
+/// round each other), the smallest is dropped.
+fn rule_of(
+    rules: &mut BTreeMap<String, Body>,
+    scope: Rect,
+    windows: &[Rect],
+    leaf: &dyn Fn(&mut BTreeMap<String, Body>, &Rect) -> String,
+) -> String {
     match windows {
         [] => return "Wall".into(),
-        [w] if *w == scope => return "Window".into(),
+        [w] if *w == scope => return leaf(rules, w),
         _ => {}
     }
     for (dir, base) in [(Dir::Y, "Stack"), (Dir::X, "Row")] {
@@ -104,7 +96,7 @@ fn rule_of(rules: &mut BTreeMap<String, Body>, scope: Rect, windows: &[Rect]) ->
                         ..scope
                     },
                 };
-                (s, e, rule_of(rules, sub, &members))
+                (s, e, rule_of(rules, sub, &members, leaf))
             })
             .collect();
         let body = split_between(dir, a, b, &items);
@@ -119,17 +111,25 @@ fn rule_of(rules: &mut BTreeMap<String, Body>, scope: Rect, windows: &[Rect]) ->
         .filter(|&(i, _)| i != smallest)
         .map(|(_, r)| *r)
         .collect();
-    rule_of(rules, scope, &rest)
+    rule_of(rules, scope, &rest, leaf)
 }
 
 /// The grammar of a `width` × `height` facade with `windows` (photo pixels, clipped to it)
-/// and wall elsewhere.
-pub fn grammar_of_windows(windows: &[Rect], width: u32, height: u32) -> Grammar {
+/// and wall elsewhere. Each window's sides move as `refinement` says, and it gets its frame
+/// and sill where they fit (inside the facade, clear of the other windows and their frames);
+/// the others stay bare.
+pub fn grammar_of_windows(
+    windows: &[Rect],
+    width: u32,
+    height: u32,
+    refinement: Refinement,
+) -> Grammar {
     let mut rules = BTreeMap::new();
     rules.insert("Wall".to_string(), Body::Leaf(Class::Wall));
     rules.insert("Window".to_string(), Body::Leaf(Class::Window));
     let inside: Vec<Rect> = windows
         .iter()
+        .map(|r| refinement.window(r))
         .map(|r| Rect {
             x0: r.x0.min(width),
             y0: r.y0.min(height),
@@ -144,7 +144,21 @@ pub fn grammar_of_windows(windows: &[Rect], width: u32, height: u32) -> Grammar 
         x1: width,
         y1: height,
     };
-    let top = rule_of(&mut rules, full, &inside);
+    let units = units_of(&inside, refinement, width, height);
+    let leaf = |rules: &mut BTreeMap<String, Body>, u: &Rect| {
+        let k = units.iter().position(|(unit, _)| unit == u);
+        match k.map(|k| (units[k].1, *u)) {
+            Some((w, u)) if w != u => framed_window(
+                rules,
+                refinement,
+                (w.x1 - w.x0) as f64,
+                (w.y1 - w.y0) as f64,
+            ),
+            _ => "Window".into(),
+        }
+    };
+    let unit_rects: Vec<Rect> = units.iter().map(|(u, _)| *u).collect();
+    let top = rule_of(&mut rules, full, &unit_rects, &leaf);
     let facade = rules.get(&top).cloned().unwrap_or(Body::Leaf(Class::Wall));
     rules.insert("Facade".to_string(), facade);
     let used_elsewhere = rules.values().any(|b| match b {
@@ -159,6 +173,37 @@ pub fn grammar_of_windows(windows: &[Rect], width: u32, height: u32) -> Grammar 
         rules,
         axiom: "Facade".into(),
         size: (width as f64, height as f64),
+    }
+}
+
+/// Each window's unit (the window with `r`'s frame and sill) and the window: the unit where it
+/// lies inside the `width` × `height` facade and clear of every other unit, else the bare
+/// window (taking a frame back can only clear more room, so this settles).
+fn units_of(windows: &[Rect], r: Refinement, width: u32, height: u32) -> Vec<(Rect, Rect)> {
+    let mut units: Vec<(Rect, Rect)> = windows.iter().map(|w| (r.unit(w), *w)).collect();
+    if r.is_none() {
+        return units;
+    }
+    loop {
+        let mut changed = false;
+        for i in 0..units.len() {
+            let (u, w) = units[i];
+            if u == w {
+                continue;
+            }
+            let outside = u.x1 > width || u.y1 > height || w.x0 < r.frame || w.y0 < r.frame;
+            let overlaps = units
+                .iter()
+                .enumerate()
+                .any(|(j, (v, _))| j != i && u.intersection(v) > 0);
+            if outside || overlaps {
+                units[i].0 = w;
+                changed = true;
+            }
+        }
+        if !changed {
+            return units;
+        }
     }
 }
 
@@ -180,7 +225,7 @@ mod tests {
             Rect::new(40, 60, 60, 90),
             Rect::new(70, 80, 90, 110),
         ];
-        let g = grammar_of_windows(&windows, 100, 120);
+        let g = grammar_of_windows(&windows, 100, 120, Refinement::default());
         let leaves = g.derive(100.0, 120.0).expect("derives");
         let parse = rasterize(&leaves, 100, 120);
         let mut got = parse.windows.clone();
@@ -205,7 +250,7 @@ mod tests {
                 (0..3).map(move |j| Rect::new(10 + 30 * j, 10 + 40 * i, 30 + 30 * j, 40 + 40 * i))
             })
             .collect();
-        let g = grammar_of_windows(&windows, 100, 130);
+        let g = grammar_of_windows(&windows, 100, 130, Refinement::default());
         // three identical rows: one rule for a row of windows
         let text = g.to_text();
         assert!(text.contains("Row1 --> split(x)"), "{text}");
@@ -219,7 +264,7 @@ mod tests {
         let windows: Vec<Rect> = (0..4)
             .map(|j| Rect::new(10 + 30 * j, 10, 30 + 30 * j, 40))
             .collect();
-        let g = grammar_of_windows(&windows, 130, 60);
+        let g = grammar_of_windows(&windows, 130, 60, Refinement::default());
         for (w, h) in [(97.5, 45.0), (195.0, 90.0)] {
             let leaves = g.derive(w, h).expect("derives");
             let wins: Vec<_> = leaves.iter().filter(|l| l.class == Class::Window).collect();
@@ -232,7 +277,7 @@ mod tests {
 
     #[test]
     fn no_windows_is_plain_wall() {
-        let g = grammar_of_windows(&[], 50, 40);
+        let g = grammar_of_windows(&[], 50, 40, Refinement::default());
         let leaves = g.derive(50.0, 40.0).expect("derives");
         assert_eq!(leaves.len(), 1);
         assert_eq!(leaves[0].class, Class::Wall);

@@ -223,8 +223,9 @@ when it failed), and total.",
 of the grammar: those found one by one, or the layout's cells holding a window), element (the
 library element recognised for the windows and inserted by the grammar, e.g. `window_cross`),
 element_score (the share of the mean window's variance its front view explains),
-element_scores (that share for every window element of the library), rules (the rule file)};
-empty when the parse failed.",
+element_scores (that share for every window element of the library), frame and sill (the
+width of the frame round the windows and the height of the sill below them, pixels, 0 for
+none: tile refinement), rules (the rule file)}; empty when the parse failed.",
         |a: &mut FacadeAnalysis| {
             let mut m = Map::new();
             if let Ok((g, s)) = &a.0.parse {
@@ -233,6 +234,8 @@ empty when the parse failed.",
                     ("tile", s.tile as INT),
                     ("floors", s.count.0 as INT),
                     ("tiles", s.count.1 as INT),
+                    ("frame", s.refinement.frame as INT),
+                    ("sill", s.refinement.sill as INT),
                     (
                         "windows",
                         if !s.from_windows {
