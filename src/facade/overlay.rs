@@ -1,5 +1,5 @@
 //! Diagnostic overlays: the detected structure drawn over the image it was found in (floor
-//! splits, tile splits, windows), or, when the analysis failed, the line segments it saw, so a
+//! splits, tile splits, windows, their frames and sills), or, when the analysis failed, the line segments it saw, so a
 //! user can tell a bad photo from a bad parameter.
 
 use image::{Rgb, RgbImage};
@@ -13,6 +13,7 @@ const FLOOR: Rgb<u8> = Rgb([255, 210, 0]);
 const TILE: Rgb<u8> = Rgb([0, 220, 255]);
 const WINDOW: Rgb<u8> = Rgb([255, 40, 40]);
 const DOOR: Rgb<u8> = Rgb([60, 255, 60]);
+const MOULDING: Rgb<u8> = Rgb([255, 140, 0]);
 const VERTICAL: Rgb<u8> = Rgb([60, 255, 60]);
 const OTHER: Rgb<u8> = Rgb([60, 140, 255]);
 const FAILED: Rgb<u8> = Rgb([255, 0, 0]);
@@ -48,7 +49,8 @@ fn outline(img: &mut RgbImage, x0: f64, y0: f64, x1: f64, y1: f64, colour: Rgb<u
 }
 
 /// The parse drawn over the (rectified) photo: floor split rows in yellow, tile split columns
-/// in cyan, windows outlined in red, doors in green.
+/// in cyan, frames and sills (wall leaves with an element) in orange, windows outlined in red,
+/// doors in green.
 pub fn structure(
     img: &RgbImage,
     floor_rows: &[f64],
@@ -62,6 +64,13 @@ pub fn structure(
     }
     for &x in tile_columns {
         line(&mut out, [x, 0.0], [x, h], TILE, 1);
+    }
+    for l in leaves
+        .iter()
+        .filter(|l| l.class == Class::Wall && l.element.is_some())
+    {
+        let s = l.scope;
+        outline(&mut out, s.x0, s.y0, s.x1 - 1.0, s.y1 - 1.0, MOULDING, 1);
     }
     for l in leaves {
         let c = match l.class {
@@ -106,5 +115,34 @@ mod tests {
         assert!((0..10).all(|x| img.get_pixel(x, 5) == &WINDOW));
         assert_eq!(img.get_pixel(3, 3), &Rgb([0, 0, 0]));
         line(&mut img, [f64::NAN, 0.0], [3.0, 3.0], WINDOW, 1);
+    }
+
+    #[test]
+    fn sills_are_drawn_and_plain_wall_is_not() {
+        use crate::facade::grammar::Scope;
+        let leaf = |y0: f64, y1: f64, class: Class, element: Option<usize>| {
+            let scope = Scope {
+                x0: 2.0,
+                y0,
+                x1: 8.0,
+                y1,
+            };
+            Leaf {
+                scope,
+                class,
+                source: scope,
+                element,
+            }
+        };
+        let img = RgbImage::new(10, 20);
+        let leaves = [
+            leaf(0.0, 2.0, Class::Wall, None),
+            leaf(2.0, 12.0, Class::Window, None),
+            leaf(12.0, 15.0, Class::Wall, Some(0)),
+        ];
+        let out = structure(&img, &[], &[], &leaves);
+        assert_eq!(out.get_pixel(4, 0), &Rgb([0, 0, 0]), "plain wall");
+        assert_eq!(out.get_pixel(4, 2), &WINDOW);
+        assert_eq!(out.get_pixel(4, 14), &MOULDING, "the sill's bottom edge");
     }
 }
