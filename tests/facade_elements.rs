@@ -11,9 +11,11 @@ use emilion::facade::element_library::{insert_elements, Library};
 use emilion::facade::element_match::recognise_elements;
 use emilion::facade::facade_mesh::{build, check_closed, MeshParams, Surface};
 use emilion::facade::grammar::Grammar;
+use emilion::facade::gray::Gray;
 use emilion::facade::parse::{parse, Priors};
 use emilion::facade::tile_refinement::Refinement;
-use emilion::facade::Class;
+use emilion::facade::window_grammar::grammar_of_windows;
+use emilion::facade::{Class, Rect};
 
 #[test]
 fn windows_drawn_from_each_element_are_recognised_and_inserted() {
@@ -191,4 +193,133 @@ fn a_hand_written_rule_file_builds_closed_facades_with_its_elements() {
             .fold(f64::INFINITY, f64::min);
         assert!(lowest.abs() < 1e-12, "door element starts at {lowest} m");
     }
+}
+
+/// A wall with an upper row of five tall windows of `upper`'s type, a lower row of five wide
+/// windows of `lower`'s, and two odd plain windows (too few to be a size of their own); light
+/// bars on dark glass, with noise. Returns the picture and every window with its type.
+fn two_rows(lib: &Library, upper: &str, lower: &str) -> (Gray, Vec<(Rect, String)>) {
+    let (w, h) = (420u32, 200u32);
+    let kinds: Vec<(Rect, String)> = (0..5)
+        .map(|k| {
+            (
+                Rect::new(20 + 80 * k, 20, 56 + 80 * k, 72),
+                upper.to_string(),
+            )
+        })
+        .chain((0..5).map(|k| {
+            (
+                Rect::new(14 + 80 * k, 110, 62 + 80 * k, 146),
+                lower.to_string(),
+            )
+        }))
+        .chain([
+            (Rect::new(30, 165, 44, 185), "window_plain".to_string()),
+            (Rect::new(350, 160, 380, 190), "window_plain".to_string()),
+        ])
+        .collect();
+    let masks: Vec<Vec<f64>> = kinds
+        .iter()
+        .map(|(r, name)| {
+            let m = lib.get(name).expect("element");
+            m.front_mask((r.x1 - r.x0) as usize, (r.y1 - r.y0) as usize)
+        })
+        .collect();
+    let mut s = 3u64;
+    let mut data = Vec::with_capacity((w * h) as usize);
+    for y in 0..h {
+        for x in 0..w {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let noise = ((s >> 40) as f64 / (1u64 << 24) as f64 - 0.5) * 40.0;
+            let inside = kinds
+                .iter()
+                .position(|(r, _)| (r.x0..r.x1).contains(&x) && (r.y0..r.y1).contains(&y));
+            let base = match inside {
+                Some(k) => {
+                    let r = kinds[k].0;
+                    if masks[k][((y - r.y0) * (r.x1 - r.x0) + x - r.x0) as usize] > 0.5 {
+                        215.0
+                    } else {
+                        55.0
+                    }
+                }
+                None => 160.0,
+            };
+            data.push((base + noise).clamp(0.0, 255.0) as u8);
+        }
+    }
+    let img = Gray {
+        width: w,
+        height: h,
+        data,
+    };
+    (img, kinds)
+}
+
+/// The element each window of `kinds` gets from `g`.
+fn elements_of(g: &Grammar, img: &Gray, kinds: &[(Rect, String)]) -> Vec<String> {
+    let leaves = g
+        .derive(img.width as f64, img.height as f64)
+        .expect("derives");
+    let names = g.elements();
+    kinds
+        .iter()
+        .map(|(r, _)| {
+            let l = leaves
+                .iter()
+                .find(|l| {
+                    l.class == Class::Window
+                        && l.scope.x0 == r.x0 as f64
+                        && l.scope.y0 == r.y0 as f64
+                })
+                .expect("the window is in the parse");
+            names[l.element.expect("an element")].clone()
+        })
+        .collect()
+}
+
+#[test]
+fn windows_of_two_sizes_and_two_types_each_get_their_element() {
+    let lib = Library::builtin().expect("library");
+    let (img, kinds) = two_rows(&lib, "window_cross", "window_sash");
+    let rects: Vec<Rect> = kinds.iter().map(|k| k.0).collect();
+    let mut g = grammar_of_windows(&rects, img.width, img.height, Refinement::default());
+    // two sizes of five: `Window` (the upper row's, first) and `Window2`; the odd two join
+    // `Window`
+    assert!(g.rules.contains_key("Window2") && !g.rules.contains_key("Window3"));
+    let found = recognise_elements(&mut g, &img, &lib);
+    let text = g.to_text();
+    eprintln!("{found:?}\n{text}");
+    let got = elements_of(&g, &img, &kinds);
+    assert_eq!(
+        &got[..10],
+        &kinds[..10].iter().map(|k| k.1.clone()).collect::<Vec<_>>()[..]
+    );
+    assert!(
+        text.contains("Window --> insert(window, window_cross)"),
+        "{text}"
+    );
+    assert!(
+        text.contains("Window2 --> insert(window, window_sash)"),
+        "{text}"
+    );
+    assert_eq!(
+        found.len(),
+        2,
+        "all the windows, then the lower row's own: {found:?}"
+    );
+    assert_eq!(found[1].rule.as_deref(), Some("Window2"));
+    assert_eq!(Grammar::parse(&text).expect("reads back"), g);
+    // one type in both sizes: the rules merge back into one, every window a cross window
+    let (img, kinds) = two_rows(&lib, "window_cross", "window_cross");
+    let rects: Vec<Rect> = kinds.iter().map(|k| k.0).collect();
+    let mut g = grammar_of_windows(&rects, img.width, img.height, Refinement::default());
+    assert!(g.rules.contains_key("Window2"));
+    let found = recognise_elements(&mut g, &img, &lib);
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert!(!g.rules.contains_key("Window2"), "{}", g.to_text());
+    let got = elements_of(&g, &img, &kinds);
+    assert!(got.iter().all(|e| e == "window_cross"), "{got:?}");
 }

@@ -16,10 +16,11 @@
 //! lacks, so a cross does not win on a window with a single mullion.
 
 use super::element_library::Library;
-use super::grammar::Grammar;
+use super::grammar::{Body, Grammar};
 use super::gray::Gray;
 use super::labels::Class;
 use super::rect::Rect;
+use super::window_grammar::MIN_GROUP;
 
 /// Side of the grid every instance is resampled to (even: its centre lies between cells).
 pub const GRID: usize = 24;
@@ -42,6 +43,19 @@ pub struct ElementMatch {
     pub scores: Vec<(String, f64)>,
     /// How many instances were averaged.
     pub instances: usize,
+    /// The rule whose instances these are when they are one size's only (`None`: all the
+    /// instances of the class).
+    pub rule: Option<String>,
+}
+
+impl ElementMatch {
+    /// The share of variance the chosen element explains.
+    pub fn explained(&self) -> f64 {
+        self.scores
+            .iter()
+            .find(|s| s.0 == self.element)
+            .map_or(0.0, |s| s.1)
+    }
 }
 
 /// The instance in `r` (photo pixels) resampled bilinearly to `GRID` × `GRID` cell centres and
@@ -222,35 +236,88 @@ pub fn recognise(
         element: best,
         scores,
         instances,
+        rule: None,
     })
 }
 
 /// Recognises the element of the windows and of the doors of `grammar` (derived at the size
-/// of `img`, the rectified photo it was parsed from) and makes their rules insert it. Returns
-/// a match per class that has instances.
+/// of `img`, the rectified photo it was parsed from) and makes their rules insert it. All the
+/// instances of a class are recognised together first; then, where the class has several
+/// rules (windows of several sizes, [`super::window_grammar`]), the instances of each rule
+/// with at least [`MIN_GROUP`] of them on their own: a rule whose instances show another
+/// element than the whole (explaining at least [`MIN_EXPLAINED`]) gets that element, the
+/// others the whole's (a few windows averaged are noisier than all). Returns the match of
+/// all the instances of each class that has any, then the matches that gave a rule its own
+/// element (with [`ElementMatch::rule`] set).
 pub fn recognise_elements(
     grammar: &mut Grammar,
     img: &Gray,
     library: &Library,
 ) -> Vec<ElementMatch> {
-    let Ok(leaves) = grammar.derive(img.width as f64, img.height as f64) else {
+    let (w, h) = (img.width as f64, img.height as f64);
+    let rect = |l: &super::grammar::Leaf| {
+        let r = |v: f64| v.round().max(0.0) as u32;
+        Rect::new(r(l.scope.x0), r(l.scope.y0), r(l.scope.x1), r(l.scope.y1))
+    };
+    let Ok(leaves) = grammar.derive(w, h) else {
         return Vec::new();
     };
     let mut found = Vec::new();
+    let mut own = Vec::new();
     for class in [Class::Window, Class::Door] {
         let rects: Vec<Rect> = leaves
             .iter()
             .filter(|l| l.class == class && l.element.is_none())
-            .map(|l| {
-                let r = |v: f64| v.round().max(0.0) as u32;
-                Rect::new(r(l.scope.x0), r(l.scope.y0), r(l.scope.x1), r(l.scope.y1))
-            })
+            .map(rect)
             .collect();
-        if let Some(m) = recognise(img, &rects, library, class) {
-            grammar.insert_element(class, &m.element);
-            found.push(m);
+        let Some(whole) = recognise(img, &rects, library, class) else {
+            continue;
+        };
+        let rules: Vec<String> = grammar
+            .rules
+            .iter()
+            .filter(|(_, b)| **b == Body::Leaf(class))
+            .map(|(n, _)| n.clone())
+            .collect();
+        for rule in &rules {
+            let mut element = whole.element.clone();
+            if rules.len() > 1 {
+                let mine: Vec<Rect> = grammar
+                    .leaves_of(rule, w, h)
+                    .unwrap_or_default()
+                    .iter()
+                    .map(rect)
+                    .collect();
+                let m = (mine.len() >= MIN_GROUP)
+                    .then(|| recognise(img, &mine, library, class))
+                    .flatten();
+                if let Some(m) =
+                    m.filter(|m| m.element != whole.element && m.explained() >= MIN_EXPLAINED)
+                {
+                    element = m.element.clone();
+                    own.push(ElementMatch {
+                        rule: Some(rule.clone()),
+                        ..m
+                    });
+                }
+            }
+            grammar
+                .rules
+                .insert(rule.clone(), Body::Insert { class, element });
         }
+        // rules left inserting the same element are one rule again (the first of them)
+        for (k, rule) in rules.iter().enumerate().skip(1) {
+            let body = grammar.rules.get(rule).cloned();
+            if let Some(first) = rules[..k]
+                .iter()
+                .find(|r| grammar.rules.get(*r) == body.as_ref())
+            {
+                grammar.merge_rule(rule, first);
+            }
+        }
+        found.push(whole);
     }
+    found.extend(own);
     found
 }
 

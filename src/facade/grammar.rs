@@ -204,6 +204,53 @@ impl Grammar {
         n
     }
 
+    /// Makes every reference to rule `from` one to `into` and removes `from` (rules with the
+    /// same body merged: the rule file says it once).
+    pub fn merge_rule(&mut self, from: &str, into: &str) {
+        if from == into || !self.rules.contains_key(into) {
+            return;
+        }
+        self.rules.remove(from);
+        for body in self.rules.values_mut() {
+            match body {
+                Body::Split { parts, .. } => parts
+                    .iter_mut()
+                    .filter(|(_, r)| r == from)
+                    .for_each(|(_, r)| *r = into.to_string()),
+                Body::Repeat { rule, .. } if rule == from => *rule = into.to_string(),
+                _ => {}
+            }
+        }
+        if self.axiom == from {
+            self.axiom = into.to_string();
+        }
+    }
+
+    /// The leaves that rule `name` (a leaf rule) makes when the facade is derived at `width` ×
+    /// `height`; empty for a rule that is not a leaf.
+    pub fn leaves_of(&self, name: &str, width: f64, height: f64) -> Result<Vec<Leaf>, String> {
+        let Some(Body::Leaf(class)) = self.rules.get(name) else {
+            return Ok(Vec::new());
+        };
+        // the rule marked with an element no rule file can name
+        const MARK: &str = "\u{0}mark";
+        let mut marked = self.clone();
+        marked.rules.insert(
+            name.to_string(),
+            Body::Insert {
+                class: *class,
+                element: MARK.into(),
+            },
+        );
+        let k = marked.elements().iter().position(|e| e == MARK);
+        Ok(marked
+            .derive(width, height)?
+            .into_iter()
+            .filter(|l| l.element == k)
+            .map(|l| Leaf { element: None, ..l })
+            .collect())
+    }
+
     fn expand(
         &self,
         name: &str,

@@ -93,6 +93,7 @@ pub fn grammar_of(s: &Structure, width: u32, height: u32, refinement: Refinement
         refinement,
         (bare.x1 - bare.x0) as f64,
         (bare.y1 - bare.y0) as f64,
+        "Window",
     );
     // one window-cell rule per distinct cell width: wall, the window, wall
     let mut tiles_seen: Vec<u64> = Vec::new();

@@ -236,14 +236,21 @@ pub fn measure(img: &Gray, windows: &[Rect], snap: bool) -> Refinement {
     }
 }
 
-/// The rule for a `w` × `h` window (facade units) with `r`'s frame and sill round it, added to
-/// `rules` (shared by windows of one size): `Window` alone when there is nothing round it;
+/// The rule for a `w` × `h` window (facade units, its rule `window`) with `r`'s frame and sill
+/// round it, added to `rules` (shared by windows of one size): `window` alone when there is
+/// nothing round it;
 /// else the window between strips of `Frame` (`split(x)` in a row `JambsN`, `split(y)` for the
 /// head and the bottom) above a `Sill`, in a rule `FramedWindowN` whose scope is
 /// [`Refinement::unit`].
-pub fn framed_window(rules: &mut BTreeMap<String, Body>, r: Refinement, w: f64, h: f64) -> String {
+pub fn framed_window(
+    rules: &mut BTreeMap<String, Body>,
+    r: Refinement,
+    w: f64,
+    h: f64,
+    window: &str,
+) -> String {
     if r.is_none() {
-        return "Window".into();
+        return window.into();
     }
     let (f, s) = (r.frame as f64, r.sill as f64);
     let mut parts: Vec<(Size, String)> = Vec::new();
@@ -260,13 +267,13 @@ pub fn framed_window(rules: &mut BTreeMap<String, Body>, r: Refinement, w: f64, 
             dir: Dir::X,
             parts: vec![
                 (Size::Fixed(f), "Frame".into()),
-                (Size::Fixed(w), "Window".into()),
+                (Size::Fixed(w), window.into()),
                 (Size::Fixed(f), "Frame".into()),
             ],
         };
         named(rules, row, "Jambs")
     } else {
-        "Window".into()
+        window.into()
     };
     parts.push((Size::Fixed(h), middle));
     if r.frame > 0 {
@@ -396,9 +403,9 @@ mod tests {
             frame: 2,
             sill: 3,
         };
-        let name = framed_window(&mut rules, r, 20.0, 35.0);
+        let name = framed_window(&mut rules, r, 20.0, 35.0, "Window");
         assert_eq!(
-            framed_window(&mut rules, r, 20.0, 35.0),
+            framed_window(&mut rules, r, 20.0, 35.0, "Window"),
             name,
             "one rule per size"
         );

@@ -126,7 +126,6 @@ pub fn grammar_of_windows(
 ) -> Grammar {
     let mut rules = BTreeMap::new();
     rules.insert("Wall".to_string(), Body::Leaf(Class::Wall));
-    rules.insert("Window".to_string(), Body::Leaf(Class::Window));
     let inside: Vec<Rect> = windows
         .iter()
         .map(|r| refinement.window(r))
@@ -145,16 +144,22 @@ pub fn grammar_of_windows(
         y1: height,
     };
     let units = units_of(&inside, refinement, width, height);
+    let sizes = size_groups(&inside);
     let leaf = |rules: &mut BTreeMap<String, Body>, u: &Rect| {
         let k = units.iter().position(|(unit, _)| unit == u);
+        let name = window_rule(k.map_or(0, |k| sizes[k]));
+        rules
+            .entry(name.clone())
+            .or_insert(Body::Leaf(Class::Window));
         match k.map(|k| (units[k].1, *u)) {
             Some((w, u)) if w != u => framed_window(
                 rules,
                 refinement,
                 (w.x1 - w.x0) as f64,
                 (w.y1 - w.y0) as f64,
+                &name,
             ),
-            _ => "Window".into(),
+            _ => name,
         }
     };
     let unit_rects: Vec<Rect> = units.iter().map(|(u, _)| *u).collect();
@@ -166,7 +171,7 @@ pub fn grammar_of_windows(
         Body::Repeat { rule, .. } => *rule == top,
         Body::Leaf(_) | Body::Insert { .. } => false,
     });
-    if top != "Wall" && top != "Window" && !used_elsewhere {
+    if !matches!(rules.get(&top), Some(Body::Leaf(_))) && !used_elsewhere {
         rules.remove(&top);
     }
     Grammar {
@@ -174,6 +179,64 @@ pub fn grammar_of_windows(
         axiom: "Facade".into(),
         size: (width as f64, height as f64),
     }
+}
+
+/// Windows whose widths and heights both differ by at most this share of the larger are of
+/// one size (single linkage). Each size of at least [`MIN_GROUP`] windows has its own window
+/// rule (`Window` for the size most windows have, and the sizes of fewer windows; then
+/// `Window2`, …), so element recognition can give each its own element
+/// ([`super::element_match::recognise_elements`], which merges the rules again where it
+/// does not).
+pub const SAME_SIZE: f64 = 0.15;
+
+/// Fewest windows of one size for a rule (and a recognition) of their own.
+pub const MIN_GROUP: usize = 3;
+
+/// The rule of the windows of size group `k`.
+fn window_rule(k: usize) -> String {
+    if k == 0 {
+        "Window".into()
+    } else {
+        format!("Window{}", k + 1)
+    }
+}
+
+/// The size group of each window: groups by [`SAME_SIZE`], numbered from the one with most
+/// windows (ties: the one whose first window comes first); windows of groups smaller than
+/// [`MIN_GROUP`] are in group 0.
+fn size_groups(windows: &[Rect]) -> Vec<usize> {
+    let n = windows.len();
+    let mut root: Vec<usize> = (0..n).collect();
+    fn find(root: &mut [usize], mut i: usize) -> usize {
+        while root[i] != i {
+            root[i] = root[root[i]];
+            i = root[i];
+        }
+        i
+    }
+    let close = |a: u32, b: u32| a.abs_diff(b) as f64 <= SAME_SIZE * a.max(b) as f64;
+    for i in 0..n {
+        for j in i + 1..n {
+            let (a, b) = (&windows[i], &windows[j]);
+            if close(a.x1 - a.x0, b.x1 - b.x0) && close(a.y1 - a.y0, b.y1 - b.y0) {
+                let (ri, rj) = (find(&mut root, i), find(&mut root, j));
+                root[ri.max(rj)] = ri.min(rj);
+            }
+        }
+    }
+    let roots: Vec<usize> = (0..n).map(|i| find(&mut root, i)).collect();
+    // (count, first window) of each group, most windows first
+    let mut order: Vec<(usize, usize)> = (0..n)
+        .filter(|&i| roots[i] == i)
+        .map(|r| (roots.iter().filter(|&&q| q == r).count(), r))
+        .collect();
+    order.sort_by_key(|&(count, first)| (std::cmp::Reverse(count), first));
+    // sizes of too few windows go with the most common one
+    order.retain(|&(count, _)| count >= MIN_GROUP);
+    roots
+        .iter()
+        .map(|r| order.iter().position(|o| o.1 == *r).unwrap_or(0))
+        .collect()
 }
 
 /// Each window's unit (the window with `r`'s frame and sill) and the window: the unit where it

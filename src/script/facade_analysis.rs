@@ -12,7 +12,7 @@ use super::facade::Labels;
 use super::{getter, register};
 use crate::facade::analysis::{analyze, Analysis, Options, Rectify};
 use crate::facade::facade_mesh::MeshParams;
-use crate::facade::grammar::Grammar;
+use crate::facade::grammar::{Body, Grammar};
 use crate::facade::homography::warp_labels;
 use crate::facade::outputs::{write_generated, write_outputs, OutputOptions};
 use crate::facade::parse::{rasterize, round_trip};
@@ -225,7 +225,9 @@ library element recognised for the windows and inserted by the grammar, e.g. `wi
 element_score (the share of the mean window's variance its front view explains),
 element_scores (that share for every window element of the library), frame and sill (the
 width of the frame round the windows and the height of the sill below them, pixels, 0 for
-none: tile refinement), rules (the rule file)}; empty when the parse failed.",
+none: tile refinement), window_elements (the element each window rule inserts, e.g.
+#{Window: \"window_sash\", Window2: \"window_cross\"}: windows of another size whose own
+element differs get their own), rules (the rule file)}; empty when the parse failed.",
         |a: &mut FacadeAnalysis| {
             let mut m = Map::new();
             if let Ok((g, s)) = &a.0.parse {
@@ -258,6 +260,18 @@ none: tile refinement), rules (the rule file)}; empty when the parse failed.",
                         .collect();
                     m.insert("element_scores".into(), Dynamic::from_map(all));
                 }
+                let per_rule: Map = g
+                    .rules
+                    .iter()
+                    .filter_map(|(n, b)| match b {
+                        Body::Insert {
+                            class: Class::Window,
+                            element,
+                        } => Some((n.as_str().into(), Dynamic::from(element.clone()))),
+                        _ => None,
+                    })
+                    .collect();
+                m.insert("window_elements".into(), Dynamic::from_map(per_rule));
                 m.insert("rules".into(), Dynamic::from(g.to_text()));
             }
             m
