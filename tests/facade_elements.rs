@@ -225,36 +225,22 @@ fn two_rows(lib: &Library, upper: &str, lower: &str) -> (Gray, Vec<(Rect, String
             m.front_mask((r.x1 - r.x0) as usize, (r.y1 - r.y0) as usize)
         })
         .collect();
-    let mut s = 3u64;
-    let mut data = Vec::with_capacity((w * h) as usize);
-    for y in 0..h {
-        for x in 0..w {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            let noise = ((s >> 40) as f64 / (1u64 << 24) as f64 - 0.5) * 40.0;
-            let inside = kinds
-                .iter()
-                .position(|(r, _)| (r.x0..r.x1).contains(&x) && (r.y0..r.y1).contains(&y));
-            let base = match inside {
-                Some(k) => {
-                    let r = kinds[k].0;
-                    if masks[k][((y - r.y0) * (r.x1 - r.x0) + x - r.x0) as usize] > 0.5 {
-                        215.0
-                    } else {
-                        55.0
-                    }
+    let img = Gray::painted(w, h, 3, 40.0, |x, y| {
+        let inside = kinds
+            .iter()
+            .position(|(r, _)| (r.x0..r.x1).contains(&x) && (r.y0..r.y1).contains(&y));
+        match inside {
+            Some(k) => {
+                let r = kinds[k].0;
+                if masks[k][((y - r.y0) * (r.x1 - r.x0) + x - r.x0) as usize] > 0.5 {
+                    215.0
+                } else {
+                    55.0
                 }
-                None => 160.0,
-            };
-            data.push((base + noise).clamp(0.0, 255.0) as u8);
+            }
+            None => 160.0,
         }
-    }
-    let img = Gray {
-        width: w,
-        height: h,
-        data,
-    };
+    });
     (img, kinds)
 }
 

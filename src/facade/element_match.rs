@@ -332,43 +332,20 @@ mod tests {
             .get(name)
             .expect("element")
             .front_mask(ww as usize, wh as usize);
-        let (width, height) = (n * 50 + 10, 64);
-        let mut s = 7u64;
-        let mut data = Vec::new();
-        let mut rects = Vec::new();
-        for k in 0..n {
-            rects.push(Rect::new(10 + 50 * k, 10, 10 + 50 * k + ww, 10 + wh));
-        }
-        for y in 0..height {
-            for x in 0..width {
-                s = s
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                let noise = ((s >> 40) as f64 / (1u64 << 24) as f64 - 0.5) * 60.0;
-                let inside = rects
-                    .iter()
-                    .find(|r| (r.x0..r.x1).contains(&x) && (r.y0..r.y1).contains(&y));
-                let base = match inside {
-                    Some(r) => {
-                        if mask[((y - r.y0) * ww + x - r.x0) as usize] > 0.5 {
-                            220.0
-                        } else {
-                            60.0
-                        }
-                    }
-                    None => 160.0,
-                };
-                data.push((base + noise).clamp(0.0, 255.0) as u8);
+        let rects: Vec<Rect> = (0..n)
+            .map(|k| Rect::new(10 + 50 * k, 10, 10 + 50 * k + ww, 10 + wh))
+            .collect();
+        let img = Gray::painted(n * 50 + 10, 64, 7, 60.0, |x, y| {
+            let inside = rects
+                .iter()
+                .find(|r| (r.x0..r.x1).contains(&x) && (r.y0..r.y1).contains(&y));
+            match inside {
+                Some(r) if mask[((y - r.y0) * ww + x - r.x0) as usize] > 0.5 => 220.0,
+                Some(_) => 60.0,
+                None => 160.0,
             }
-        }
-        (
-            Gray {
-                width,
-                height,
-                data,
-            },
-            rects,
-        )
+        });
+        (img, rects)
     }
 
     #[test]

@@ -38,6 +38,34 @@ impl Gray {
         }
     }
 
+    /// A synthetic picture (for tests and demonstrations): `base(x, y)` plus uniform noise of
+    /// total width `noise`, drawn pixel by pixel in row order from `seed` (a 64-bit LCG),
+    /// clamped to 0–255.
+    pub fn painted(
+        width: u32,
+        height: u32,
+        seed: u64,
+        noise: f64,
+        base: impl Fn(u32, u32) -> f64,
+    ) -> Self {
+        let mut s = seed;
+        let mut data = Vec::with_capacity(width as usize * height as usize);
+        for y in 0..height {
+            for x in 0..width {
+                s = s
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                let n = ((s >> 40) as f64 / (1u64 << 24) as f64 - 0.5) * noise;
+                data.push((base(x, y) + n).clamp(0.0, 255.0) as u8);
+            }
+        }
+        Gray {
+            width,
+            height,
+            data,
+        }
+    }
+
     /// Luma at (x, y).
     #[inline]
     pub fn at(&self, x: u32, y: u32) -> u8 {

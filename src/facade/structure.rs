@@ -39,18 +39,21 @@ impl WindowGrid {
     }
 }
 
+/// The root of `i` in the union-find forest `parent` (paths halved on the way): single-linkage
+/// clustering of windows, here and in [`super::window_grammar`].
+pub(crate) fn root(parent: &mut [usize], mut i: usize) -> usize {
+    while parent[i] != i {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    i
+}
+
 /// Centres of the single-linkage clusters of `rects` by interval overlap, clusters of two or
 /// more only, sorted.
 fn clusters(rects: &[Rect], interval: impl Fn(&Rect) -> (u32, u32)) -> Vec<f64> {
     let n = rects.len();
     let mut parent: Vec<usize> = (0..n).collect();
-    fn root(p: &mut [usize], mut i: usize) -> usize {
-        while p[i] != i {
-            p[i] = p[p[i]];
-            i = p[i];
-        }
-        i
-    }
     for i in 0..n {
         for j in i + 1..n {
             let (a, b) = (interval(&rects[i]), interval(&rects[j]));

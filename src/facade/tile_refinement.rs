@@ -317,57 +317,35 @@ mod tests {
     /// A wall (grey 150, noise ±10) with a row of dark windows (40) in frames of `frame` px
     /// (grey 220) over sills of `sill` px (230, then a shadow row of 90 below).
     fn wall_with_windows(frame: u32, sill: u32) -> (Gray, Vec<Rect>) {
-        let (w, h) = (260u32, 90u32);
         let windows: Vec<Rect> = (0..5)
             .map(|j| Rect::new(15 + 50 * j, 20, 35 + 50 * j, 55))
             .collect();
-        let mut s = 11u64;
-        let mut data = Vec::with_capacity((w * h) as usize);
-        for y in 0..h {
-            for x in 0..w {
-                s = s
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                let noise = ((s >> 40) as f64 / (1u64 << 24) as f64 - 0.5) * 20.0;
-                let inside = |r: &Rect| (r.x0..r.x1).contains(&x) && (r.y0..r.y1).contains(&y);
-                let r = Refinement {
-                    sides: [0; 4],
-                    frame,
-                    sill,
-                };
-                let base = if windows.iter().any(inside) {
-                    40.0
-                } else if windows
-                    .iter()
-                    .any(|q| inside(&Refinement { sill: 0, ..r }.unit(q)))
-                {
-                    220.0
-                } else if windows.iter().any(|q| inside(&r.unit(q))) {
-                    230.0
-                } else if windows.iter().any(|q| {
-                    inside(
-                        &Refinement {
-                            sill: sill + 1,
-                            ..r
-                        }
-                        .unit(q),
-                    ) && sill > 0
-                }) {
-                    90.0
-                } else {
-                    150.0
-                };
-                data.push((base + noise).clamp(0.0, 255.0) as u8);
+        let r = Refinement {
+            sides: [0; 4],
+            frame,
+            sill,
+        };
+        let framed = Refinement { sill: 0, ..r };
+        let shadow = Refinement {
+            sill: sill + 1,
+            ..r
+        };
+        let img = Gray::painted(260, 90, 11, 20.0, |x, y| {
+            let inside = |r: &Rect| (r.x0..r.x1).contains(&x) && (r.y0..r.y1).contains(&y);
+            let within = |k: &Refinement| windows.iter().any(|q| inside(&k.unit(q)));
+            if windows.iter().any(inside) {
+                40.0
+            } else if within(&framed) {
+                220.0
+            } else if within(&r) {
+                230.0
+            } else if sill > 0 && within(&shadow) {
+                90.0
+            } else {
+                150.0
             }
-        }
-        (
-            Gray {
-                width: w,
-                height: h,
-                data,
-            },
-            windows,
-        )
+        });
+        (img, windows)
     }
 
     #[test]

@@ -12,6 +12,7 @@ use std::collections::BTreeMap;
 use super::grammar::{Body, Dir, Grammar, Size};
 use super::labels::Class;
 use super::rect::Rect;
+use super::structure::root;
 use super::tile_refinement::{framed_window, named, Refinement};
 
 /// The extent of `r` along `dir`.
@@ -206,25 +207,18 @@ fn window_rule(k: usize) -> String {
 /// [`MIN_GROUP`] are in group 0.
 fn size_groups(windows: &[Rect]) -> Vec<usize> {
     let n = windows.len();
-    let mut root: Vec<usize> = (0..n).collect();
-    fn find(root: &mut [usize], mut i: usize) -> usize {
-        while root[i] != i {
-            root[i] = root[root[i]];
-            i = root[i];
-        }
-        i
-    }
+    let mut parent: Vec<usize> = (0..n).collect();
     let close = |a: u32, b: u32| a.abs_diff(b) as f64 <= SAME_SIZE * a.max(b) as f64;
     for i in 0..n {
         for j in i + 1..n {
             let (a, b) = (&windows[i], &windows[j]);
             if close(a.x1 - a.x0, b.x1 - b.x0) && close(a.y1 - a.y0, b.y1 - b.y0) {
-                let (ri, rj) = (find(&mut root, i), find(&mut root, j));
-                root[ri.max(rj)] = ri.min(rj);
+                let (ri, rj) = (root(&mut parent, i), root(&mut parent, j));
+                parent[ri.max(rj)] = ri.min(rj);
             }
         }
     }
-    let roots: Vec<usize> = (0..n).map(|i| find(&mut root, i)).collect();
+    let roots: Vec<usize> = (0..n).map(|i| root(&mut parent, i)).collect();
     // (count, first window) of each group, most windows first
     let mut order: Vec<(usize, usize)> = (0..n)
         .filter(|&i| roots[i] == i)
