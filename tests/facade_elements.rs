@@ -271,7 +271,7 @@ fn windows_of_two_sizes_and_two_types_each_get_their_element() {
     let lib = Library::builtin().expect("library");
     let (img, kinds) = two_rows(&lib, "window_cross", "window_sash");
     let rects: Vec<Rect> = kinds.iter().map(|k| k.0).collect();
-    let mut g = grammar_of_windows(&rects, img.width, img.height, Refinement::default());
+    let mut g = grammar_of_windows(&rects, img.width, img.height, &|_| Refinement::default());
     // two sizes of five: `Window` (the upper row's, first) and `Window2`; the odd two join
     // `Window`
     assert!(g.rules.contains_key("Window2") && !g.rules.contains_key("Window3"));
@@ -301,7 +301,7 @@ fn windows_of_two_sizes_and_two_types_each_get_their_element() {
     // one type in both sizes: the rules merge back into one, every window a cross window
     let (img, kinds) = two_rows(&lib, "window_cross", "window_cross");
     let rects: Vec<Rect> = kinds.iter().map(|k| k.0).collect();
-    let mut g = grammar_of_windows(&rects, img.width, img.height, Refinement::default());
+    let mut g = grammar_of_windows(&rects, img.width, img.height, &|_| Refinement::default());
     assert!(g.rules.contains_key("Window2"));
     let found = recognise_elements(&mut g, &img, &lib);
     assert_eq!(found.len(), 1, "{found:?}");

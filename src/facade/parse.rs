@@ -75,7 +75,8 @@ pub struct Structure {
     /// layout's windows agree with them less than [`GRID_AGREEMENT`]; otherwise the grammar
     /// is the layout's (floors and tiles that repeat).
     pub from_windows: bool,
-    /// The frame and sill round the grammar's windows ([`super::tile_refinement`]).
+    /// The frame and sill round the grammar's windows ([`super::tile_refinement`]), measured
+    /// over all of them (the grammar of windows found one by one measures each size's own).
     pub refinement: Refinement,
     /// Seconds spent in: floor search, tile search, irreducible tile, window (the layout's,
     /// with synchronisation), windows one by one (with the choice of grammar and tile refinement).
@@ -212,7 +213,8 @@ pub fn parse_region(
     let grid = grammar_of(&structure, full.width, full.height, none);
     structure.from_windows = !structure.windows.is_empty()
         && window_agreement(&grid, &structure.windows, full.width, full.height) < GRID_AGREEMENT;
-    // tile refinement: the frame and sill round the chosen grammar's windows
+    // tile refinement: the frame and sill round the chosen grammar's windows (all of them,
+    // for the report; the windows found one by one get theirs size by size)
     let windows = if structure.from_windows {
         structure.windows.clone()
     } else {
@@ -221,12 +223,9 @@ pub fn parse_region(
     };
     structure.refinement = measure(full, &windows, !structure.from_windows);
     let grammar = if structure.from_windows {
-        grammar_of_windows(
-            &structure.windows,
-            full.width,
-            full.height,
-            structure.refinement,
-        )
+        grammar_of_windows(&structure.windows, full.width, full.height, &|ws| {
+            measure(full, ws, false)
+        })
     } else {
         grammar_of(&structure, full.width, full.height, structure.refinement)
     };

@@ -320,32 +320,40 @@ mod tests {
         let windows: Vec<Rect> = (0..5)
             .map(|j| Rect::new(15 + 50 * j, 20, 35 + 50 * j, 55))
             .collect();
-        let r = Refinement {
-            sides: [0; 4],
-            frame,
-            sill,
-        };
-        let framed = Refinement { sill: 0, ..r };
-        let shadow = Refinement {
-            sill: sill + 1,
-            ..r
-        };
-        let img = Gray::painted(260, 90, 11, 20.0, |x, y| {
-            let inside = |r: &Rect| (r.x0..r.x1).contains(&x) && (r.y0..r.y1).contains(&y);
-            let within = |k: &Refinement| windows.iter().any(|q| inside(&k.unit(q)));
-            if windows.iter().any(inside) {
-                40.0
-            } else if within(&framed) {
-                220.0
-            } else if within(&r) {
-                230.0
-            } else if sill > 0 && within(&shadow) {
-                90.0
-            } else {
-                150.0
-            }
-        });
+        let img = painted_wall(260, 90, &[(&windows, frame, sill)]);
         (img, windows)
+    }
+
+    /// A `w` × `h` wall painted as in [`wall_with_windows`] with each group of windows in its
+    /// own frame and over its own sill.
+    fn painted_wall(w: u32, h: u32, groups: &[(&[Rect], u32, u32)]) -> Gray {
+        Gray::painted(w, h, 11, 20.0, |x, y| {
+            let inside = |r: &Rect| (r.x0..r.x1).contains(&x) && (r.y0..r.y1).contains(&y);
+            let mut shade = 150.0;
+            for &(windows, frame, sill) in groups {
+                let r = Refinement {
+                    sides: [0; 4],
+                    frame,
+                    sill,
+                };
+                let within = |k: Refinement| windows.iter().any(|q| inside(&k.unit(q)));
+                if windows.iter().any(inside) {
+                    return 40.0;
+                } else if within(Refinement { sill: 0, ..r }) {
+                    return 220.0;
+                } else if within(r) {
+                    return 230.0;
+                } else if sill > 0
+                    && within(Refinement {
+                        sill: sill + 1,
+                        ..r
+                    })
+                {
+                    shade = 90.0;
+                }
+            }
+            shade
+        })
     }
 
     #[test]
@@ -370,6 +378,50 @@ mod tests {
         // two windows are too few to synchronise anything
         let (img, windows) = wall_with_windows(2, 4);
         assert!(measure(&img, &windows[..2], true).is_none());
+    }
+
+    #[test]
+    fn each_size_of_window_gets_its_own_frame_and_sill() {
+        // an upper row of tall framed windows over 3 px sills, a lower row of wide bare
+        // windows over 6 px sills: synchronised size by size (local synchronisation), each
+        // row gets its own
+        let upper: Vec<Rect> = (0..5)
+            .map(|j| Rect::new(15 + 50 * j, 15, 35 + 50 * j, 50))
+            .collect();
+        let lower: Vec<Rect> = (0..5)
+            .map(|j| Rect::new(10 + 50 * j, 80, 40 + 50 * j, 100))
+            .collect();
+        let img = painted_wall(260, 125, &[(&upper, 2, 3), (&lower, 0, 6)]);
+        let windows: Vec<Rect> = upper.iter().chain(&lower).copied().collect();
+        let g = crate::facade::window_grammar::grammar_of_windows(&windows, 260, 125, &|ws| {
+            measure(&img, ws, false)
+        });
+        let leaves = g.derive(260.0, 125.0).expect("derives");
+        let names = g.elements();
+        let of = |name: &str| {
+            let k = names.iter().position(|n| n == name);
+            leaves.iter().filter(move |l| l.element == k && k.is_some())
+        };
+        // four strips of frame round each upper window, none round the lower ones
+        assert_eq!(of("wall_frame").count(), 20, "{}", g.to_text());
+        assert!(of("wall_frame").all(|l| l.scope.y1 <= 60.0));
+        // a sill under every window, as tall as it was painted
+        let sills: Vec<(f64, f64)> = of("wall_sill")
+            .map(|l| (l.scope.y0, l.scope.y1 - l.scope.y0))
+            .collect();
+        assert_eq!(sills.len(), 10, "{}", g.to_text());
+        for (y0, height) in sills {
+            let want = if y0 < 60.0 { (52.0, 3.0) } else { (100.0, 6.0) };
+            assert_eq!((y0, height), want, "{}", g.to_text());
+        }
+        // all ten synchronised together, the one frame and sill are right for neither row
+        let all = measure(&img, &windows, false);
+        assert!(
+            (all.frame, all.sill) != (2, 3) && (all.frame, all.sill) != (0, 6),
+            "{all:?}"
+        );
+        // and the parse paints the windows where they are
+        assert_eq!(rasterize(&leaves, 260, 125).windows.len(), 10);
     }
 
     #[test]

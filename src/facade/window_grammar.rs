@@ -116,20 +116,21 @@ fn rule_of(
 }
 
 /// The grammar of a `width` × `height` facade with `windows` (photo pixels, clipped to it)
-/// and wall elsewhere. Each window's sides move as `refinement` says, and it gets its frame
-/// and sill where they fit (inside the facade, clear of the other windows and their frames);
-/// the others stay bare.
+/// and wall elsewhere. The windows of each size ([`SAME_SIZE`]) get the frame and sill that
+/// `refine` finds round them (tile refinement synchronised over the windows of that size:
+/// Müller's local synchronisation; `|_| Refinement::default()` for none): their sides move
+/// as it says, and the frame and sill are added where they fit (inside the facade, clear of
+/// the other windows and their frames); the others stay bare.
 pub fn grammar_of_windows(
     windows: &[Rect],
     width: u32,
     height: u32,
-    refinement: Refinement,
+    refine: &dyn Fn(&[Rect]) -> Refinement,
 ) -> Grammar {
     let mut rules = BTreeMap::new();
     rules.insert("Wall".to_string(), Body::Leaf(Class::Wall));
-    let inside: Vec<Rect> = windows
+    let clipped: Vec<Rect> = windows
         .iter()
-        .map(|r| refinement.window(r))
         .map(|r| Rect {
             x0: r.x0.min(width),
             y0: r.y0.min(height),
@@ -138,28 +139,47 @@ pub fn grammar_of_windows(
         })
         .filter(|r| r.area() > 0)
         .collect();
+    // one refinement per size, measured on that size's windows
+    let sizes = size_groups(&clipped);
+    let per_size: Vec<Refinement> = (0..=sizes.iter().copied().max().unwrap_or(0))
+        .map(|g| {
+            let mine: Vec<Rect> = (0..clipped.len())
+                .filter(|&k| sizes[k] == g)
+                .map(|k| clipped[k])
+                .collect();
+            refine(&mine)
+        })
+        .collect();
+    let refinements: Vec<Refinement> = sizes.iter().map(|&g| per_size[g]).collect();
+    let inside: Vec<Rect> = clipped
+        .iter()
+        .zip(&refinements)
+        .map(|(r, k)| {
+            let w = k.window(r);
+            Rect {
+                x1: w.x1.min(width),
+                y1: w.y1.min(height),
+                ..w
+            }
+        })
+        .collect();
     let full = Rect {
         x0: 0,
         y0: 0,
         x1: width,
         y1: height,
     };
-    let units = units_of(&inside, refinement, width, height);
-    let sizes = size_groups(&inside);
+    let units = units_of(&inside, &refinements, width, height);
     let leaf = |rules: &mut BTreeMap<String, Body>, u: &Rect| {
         let k = units.iter().position(|(unit, _)| unit == u);
         let name = window_rule(k.map_or(0, |k| sizes[k]));
         rules
             .entry(name.clone())
             .or_insert(Body::Leaf(Class::Window));
-        match k.map(|k| (units[k].1, *u)) {
-            Some((w, u)) if w != u => framed_window(
-                rules,
-                refinement,
-                (w.x1 - w.x0) as f64,
-                (w.y1 - w.y0) as f64,
-                &name,
-            ),
+        match k.map(|k| (units[k].1, *u, refinements[k])) {
+            Some((w, u, r)) if w != u => {
+                framed_window(rules, r, (w.x1 - w.x0) as f64, (w.y1 - w.y0) as f64, &name)
+            }
             _ => name,
         }
     };
@@ -233,14 +253,20 @@ fn size_groups(windows: &[Rect]) -> Vec<usize> {
         .collect()
 }
 
-/// Each window's unit (the window with `r`'s frame and sill) and the window: the unit where it
-/// lies inside the `width` × `height` facade and clear of every other unit, else the bare
-/// window (taking a frame back can only clear more room, so this settles).
-fn units_of(windows: &[Rect], r: Refinement, width: u32, height: u32) -> Vec<(Rect, Rect)> {
-    let mut units: Vec<(Rect, Rect)> = windows.iter().map(|w| (r.unit(w), *w)).collect();
-    if r.is_none() {
-        return units;
-    }
+/// Each window's unit (the window with its refinement's frame and sill) and the window: the
+/// unit where it lies inside the `width` × `height` facade and clear of every other unit,
+/// else the bare window (taking a frame back can only clear more room, so this settles).
+fn units_of(
+    windows: &[Rect],
+    refinements: &[Refinement],
+    width: u32,
+    height: u32,
+) -> Vec<(Rect, Rect)> {
+    let mut units: Vec<(Rect, Rect)> = windows
+        .iter()
+        .zip(refinements)
+        .map(|(w, r)| (r.unit(w), *w))
+        .collect();
     loop {
         let mut changed = false;
         for i in 0..units.len() {
@@ -248,7 +274,8 @@ fn units_of(windows: &[Rect], r: Refinement, width: u32, height: u32) -> Vec<(Re
             if u == w {
                 continue;
             }
-            let outside = u.x1 > width || u.y1 > height || w.x0 < r.frame || w.y0 < r.frame;
+            let frame = refinements[i].frame;
+            let outside = u.x1 > width || u.y1 > height || w.x0 < frame || w.y0 < frame;
             let overlaps = units
                 .iter()
                 .enumerate()
@@ -282,7 +309,7 @@ mod tests {
             Rect::new(40, 60, 60, 90),
             Rect::new(70, 80, 90, 110),
         ];
-        let g = grammar_of_windows(&windows, 100, 120, Refinement::default());
+        let g = grammar_of_windows(&windows, 100, 120, &|_| Refinement::default());
         let leaves = g.derive(100.0, 120.0).expect("derives");
         let parse = rasterize(&leaves, 100, 120);
         let mut got = parse.windows.clone();
@@ -307,7 +334,7 @@ mod tests {
                 (0..3).map(move |j| Rect::new(10 + 30 * j, 10 + 40 * i, 30 + 30 * j, 40 + 40 * i))
             })
             .collect();
-        let g = grammar_of_windows(&windows, 100, 130, Refinement::default());
+        let g = grammar_of_windows(&windows, 100, 130, &|_| Refinement::default());
         // three identical rows: one rule for a row of windows
         let text = g.to_text();
         assert!(text.contains("Row1 --> split(x)"), "{text}");
@@ -321,7 +348,7 @@ mod tests {
         let windows: Vec<Rect> = (0..4)
             .map(|j| Rect::new(10 + 30 * j, 10, 30 + 30 * j, 40))
             .collect();
-        let g = grammar_of_windows(&windows, 130, 60, Refinement::default());
+        let g = grammar_of_windows(&windows, 130, 60, &|_| Refinement::default());
         for (w, h) in [(97.5, 45.0), (195.0, 90.0)] {
             let leaves = g.derive(w, h).expect("derives");
             let wins: Vec<_> = leaves.iter().filter(|l| l.class == Class::Window).collect();
@@ -334,7 +361,7 @@ mod tests {
 
     #[test]
     fn no_windows_is_plain_wall() {
-        let g = grammar_of_windows(&[], 50, 40, Refinement::default());
+        let g = grammar_of_windows(&[], 50, 40, &|_| Refinement::default());
         let leaves = g.derive(50.0, 40.0).expect("derives");
         assert_eq!(leaves.len(), 1);
         assert_eq!(leaves[0].class, Class::Wall);
