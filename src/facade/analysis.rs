@@ -99,7 +99,7 @@ impl Analysis {
 }
 
 /// Share of pixels outside the photo a facade region may keep.
-const MAX_OUTSIDE: f64 = 0.01;
+pub const MAX_OUTSIDE: f64 = 0.01;
 
 /// The largest upright rectangle of the rectified frame (`size`) that holds photo pixels
 /// (at most [`MAX_OUTSIDE`] of it outside the warped photo): the bounding box, shrunk from the

@@ -1,6 +1,6 @@
 //! The facade shape grammar (Müller et al. 2006–2007, CGA-like): a tree of splits and repeats
 //! whose leaves are facade classes, its derivation into labelled rectangles at any size, and
-//! its rule file. A [`Rule`] set is what a parse produces; deriving it at the photo's size
+//! its rule file. A [`Grammar`] (its rules) is what a parse produces; deriving it at the photo's size
 //! reproduces the parse, and at other sizes generates new facades of the same style.
 //!
 //! Sizes follow CGA: a part is either **fixed** (`12.5`: its size in facade units whatever

@@ -1,11 +1,14 @@
 //! Tile refinement (Müller et al. 2007 §3, `facade-reconstruction.md` §1): what stands round
 //! a window and below it — the frame (casing) and the sill — found with the edge-based
-//! split-line measure and synchronised across every window of the facade. A split line's
+//! split-line measure and synchronised across the windows it is given. A split line's
 //! strength is the mean grey step across it; for each distance `d` outside the window's
-//! sides (left, right, top) the strengths of all windows are averaged, and the frame's outer
-//! edge is the strongest line standing clearly out of that profile. The sill is found the
-//! same way below the window (and below the frame). Averaging over the windows is Müller's
-//! global synchronisation: a tree or a shadow on one window does not move the split.
+//! sides (left, right, top) the strengths of all those windows are averaged, and the frame's
+//! outer edge is the strongest line standing clearly out of that profile. The sill is found
+//! the same way below the window (and below the frame). Averaging over the windows is
+//! Müller's synchronisation: a tree or a shadow on one window does not move the split. The
+//! grammar of windows found one by one measures each size of window on its own (local
+//! synchronisation, [`super::window_grammar::grammar_of_windows`]); the layout's window is
+//! measured over all its cells.
 //! [`framed_window`] writes the result as rules: the window between strips of casing, and a
 //! sill under it (wall leaves carrying the `wall_frame` and `wall_sill` elements).
 

@@ -228,9 +228,9 @@ pub fn detect_windows(img: &Gray, region: &Rect, p: &BlobParams) -> Vec<Rect> {
 }
 
 /// Least overlap across the gap (share of the smaller extent) of two panes of one window.
-const PANE_ALIGN: f64 = 0.8;
+pub const PANE_ALIGN: f64 = 0.8;
 /// Greatest relative difference of the two panes' extents across the gap.
-const PANE_SIMILAR: f64 = 0.25;
+pub const PANE_SIMILAR: f64 = 0.25;
 
 /// Merges panes of one window: two rectangles side by side (or one above the other) that
 /// overlap by [`PANE_ALIGN`] of the smaller one's height (width), differ in it by at most
