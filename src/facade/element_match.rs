@@ -279,31 +279,30 @@ pub fn recognise_elements(
             .filter(|(_, b)| **b == Body::Leaf(class))
             .map(|(n, _)| n.clone())
             .collect();
-        for rule in &rules {
-            let mut element = whole.element.clone();
-            if rules.len() > 1 {
-                let mine: Vec<Rect> = grammar
-                    .leaves_of(rule, w, h)
-                    .unwrap_or_default()
-                    .iter()
-                    .map(rect)
-                    .collect();
-                let m = (mine.len() >= MIN_GROUP)
-                    .then(|| recognise(img, &mine, library, class))
-                    .flatten();
-                if let Some(m) =
-                    m.filter(|m| m.element != whole.element && m.explained() >= MIN_EXPLAINED)
-                {
-                    element = m.element.clone();
-                    own.push(ElementMatch {
-                        rule: Some(rule.clone()),
-                        ..m
-                    });
-                }
+        // every rule inserts the element of all the instances, but for the sizes whose own
+        // instances show another one
+        grammar.insert_element(class, &whole.element);
+        for rule in rules.iter().filter(|_| rules.len() > 1) {
+            let mine: Vec<Rect> = grammar
+                .leaves_of(rule, w, h)
+                .unwrap_or_default()
+                .iter()
+                .map(rect)
+                .collect();
+            let m = (mine.len() >= MIN_GROUP)
+                .then(|| recognise(img, &mine, library, class))
+                .flatten()
+                .filter(|m| m.element != whole.element && m.explained() >= MIN_EXPLAINED);
+            if let Some(m) = m {
+                let element = m.element.clone();
+                grammar
+                    .rules
+                    .insert(rule.clone(), Body::Insert { class, element });
+                own.push(ElementMatch {
+                    rule: Some(rule.clone()),
+                    ..m
+                });
             }
-            grammar
-                .rules
-                .insert(rule.clone(), Body::Insert { class, element });
         }
         // rules left inserting the same element are one rule again (the first of them)
         for (k, rule) in rules.iter().enumerate().skip(1) {

@@ -226,11 +226,13 @@ impl Grammar {
         }
     }
 
-    /// The leaves that rule `name` (a leaf rule) makes when the facade is derived at `width` ×
-    /// `height`; empty for a rule that is not a leaf.
+    /// The leaves that rule `name` (a terminal rule: a leaf or an insert) makes when the
+    /// facade is derived at `width` × `height`, without their elements; empty for a rule that
+    /// is not terminal.
     pub fn leaves_of(&self, name: &str, width: f64, height: f64) -> Result<Vec<Leaf>, String> {
-        let Some(Body::Leaf(class)) = self.rules.get(name) else {
-            return Ok(Vec::new());
+        let class = match self.rules.get(name) {
+            Some(Body::Leaf(class) | Body::Insert { class, .. }) => class,
+            _ => return Ok(Vec::new()),
         };
         // the rule marked with an element no rule file can name
         const MARK: &str = "\u{0}mark";
