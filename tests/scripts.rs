@@ -95,7 +95,7 @@ fn other_scripts_run() {
     for p in script_paths() {
         let name = p.file_stem().unwrap().to_str().unwrap().to_string();
         // the contact scripts run in tests/contact_scripts.rs, the garments in
-        // tests/garment_scripts.rs, buckle_square in tests/buckling.rs and the tracking
+        // tests/garment_scripts.rs, the buckle_* scripts in tests/buckling.rs and the tracking
         // scripts in tests/tracking_track.rs, the face scripts in tests/face_track.rs and tests/face_fit.rs,
         // with their checks
         if [
@@ -112,6 +112,7 @@ fn other_scripts_run() {
             "paco",
             "buckle_square",
             "buckle_cylinder",
+            "buckle_sleeve",
             "make_sequence",
             "track_body",
             "make_face_sequence",
