@@ -24,7 +24,7 @@
 //!   name (a FreeSewing part name, or a group id); `name` (optional) renames it. `fold`:
 //!   absent = as the SVG marks it (FreeSewing's cut-on-fold marker), a corner name = that
 //!   corner's segment is the fold, `null` = not cut on the fold. `copies`: `one` (default) or
-//!   `pair`. `placement`: see [`Placement`](super::pattern::Placement). `seam_allowance`
+//!   `pair`. `placement`: see [`Placement`]. `seam_allowance`
 //!   (optional, m) overrides the one read from the SVG.
 //! * `seams[]`: as in the JSON pattern format ([`super::json`]), naming pieces and corners
 //!   after expansion (`P_l`/`P_r` for pairs, `c3'` for mirrored corners of a folded piece).

@@ -73,7 +73,7 @@ pub struct TrackerOptions {
     pub prior_weight: f64,
     /// Limb stages also start particles from the previous frame's limb pose (no
     /// prediction), the rest pose, and the predicted limb half bent or straightened (see
-    /// [`limb_restarts`](super::restarts::limb_restarts)).
+    /// [`limb_restarts`]).
     pub limb_restarts: bool,
 }
 
