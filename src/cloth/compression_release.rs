@@ -389,7 +389,7 @@ impl CompressionRelease {
             };
             let next = p + step;
             let g = self.ring_strain(x, m, &next);
-            if !(g < f) {
+            if g.is_nan() || g >= f {
                 break;
             }
             (p, f) = (next, g);
