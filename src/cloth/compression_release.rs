@@ -21,7 +21,9 @@
 //! creased (0.0074 J stored at rest, against 1.6e-4 J now). When the near intersection lies in
 //! a body, the far one is taken only within 0.75 of the spring's rest length ([`MAX_JUMP`]):
 //! farther, the particle would jump through the cloth. Particles already in contact are not
-//! released.
+//! released. The hold yields to cloth–cloth contact ([`Filter::hold_yielding`]): a particle
+//! the self-collision response stops short of its destination is let go, and waits
+//! `hold_steps` before it is released again.
 
 use super::constraints::{ContactHook, Filter, Obstacles, ParticleFilter};
 use super::elements::SpringKind;
@@ -33,6 +35,10 @@ use crate::geometry::Vec3;
 /// destinations lay up to 1.36 rest lengths away, through the cloth, and made the spring
 /// energy leap from 0.008 to 0.046 J in one step at rest: the cloth never settled.
 pub const MAX_JUMP: f64 = 0.75;
+
+/// A held particle found farther than this from its destination (m) was stopped short by
+/// cloth–cloth contact (the solver puts a held particle on its target to rounding).
+pub const BLOCKED_TOL: f64 = 1e-9;
 
 /// Gauss–Newton steps from the intersection to the ring's least strain.
 pub const SETTLE_STEPS: usize = 4;
@@ -120,6 +126,8 @@ pub struct CompressionRelease {
     springs: Vec<(usize, usize, f64)>,
     /// Held particles: (particle, destination, steps left).
     held: Vec<(usize, Vec3, u32)>,
+    /// Steps a particle whose hold was blocked by another layer waits before its next release.
+    blocked: Vec<u32>,
     /// Scratch: particle already used this step.
     busy: Vec<bool>,
     /// Scratch: compressed springs (strain, spring).
@@ -178,6 +186,7 @@ impl CompressionRelease {
             pattern,
             springs,
             held: Vec::new(),
+            blocked: vec![0; n],
             busy: vec![false; n],
             order: Vec::new(),
             rng: crate::geometry::SplitMix64::new(options.seed),
@@ -459,13 +468,21 @@ impl ContactHook for CompressionRelease {
     ) {
         self.busy.fill(false);
         self.tie_side = None;
-        // particles still held keep their destination
+        for b in &mut self.blocked {
+            *b = b.saturating_sub(1);
+        }
+        // particles still held keep their destination, unless cloth–cloth contact stopped them
+        // short of it (the hold yields, see `Filter::hold_yielding`): another layer is in the
+        // way, and driving the particle on into it each step stretched the sleeve to 0.75 J
         self.held.retain(|h| h.2 > 0);
         let held = std::mem::take(&mut self.held);
         for &(m, q, left) in &held {
+            if (x[m] - q).norm() > BLOCKED_TOL {
+                self.blocked[m] = self.options.hold_steps.max(1);
+                continue;
+            }
             if matches!(filter.kind[m], ParticleFilter::Free) {
-                filter.kind[m] = ParticleFilter::Fixed { target: q };
-                filter.any = true;
+                filter.hold_yielding(m, q);
                 self.held.push((m, q, left - 1));
                 self.occupy(m);
             }
@@ -484,7 +501,10 @@ impl ContactHook for CompressionRelease {
         for &(_, k) in &order {
             let (a, b, _) = self.springs[k];
             for (m, partner) in [(b, a), (a, b)] {
-                if self.busy[m] || !matches!(filter.kind[m], ParticleFilter::Free) {
+                if self.busy[m]
+                    || self.blocked[m] > 0
+                    || !matches!(filter.kind[m], ParticleFilter::Free)
+                {
                     continue;
                 }
                 let dest = if self.is_grid() {
@@ -494,8 +514,7 @@ impl ContactHook for CompressionRelease {
                     self.mesh_destination(x, m, partner, obstacles)
                 };
                 if let Some(q) = dest {
-                    filter.kind[m] = ParticleFilter::Fixed { target: q };
-                    filter.any = true;
+                    filter.hold_yielding(m, q);
                     self.held
                         .push((m, q, self.options.hold_steps.saturating_sub(1)));
                     self.occupy(m);

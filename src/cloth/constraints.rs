@@ -128,6 +128,11 @@ pub struct Filter {
     pub kind: Vec<ParticleFilter>,
     /// True when any particle is constrained.
     pub any: bool,
+    /// Particles fixed by a soft hold (a compression release's destination) that yield to
+    /// cloth–cloth contact: the self-collision response moves them like free particles, so a
+    /// release never carries a particle through another layer (empty: none; indexed like
+    /// `kind` up to its length).
+    pub yields: Vec<bool>,
 }
 
 impl Filter {
@@ -136,6 +141,7 @@ impl Filter {
         Filter {
             kind: vec![ParticleFilter::Free; n],
             any: false,
+            yields: Vec::new(),
         }
     }
 
@@ -143,6 +149,24 @@ impl Filter {
     pub fn clear(&mut self) {
         self.kind.fill(ParticleFilter::Free);
         self.any = false;
+        self.yields.clear();
+    }
+
+    /// Fixes particle `i` at `target` by a soft hold that yields to cloth–cloth contact (see
+    /// [`Filter::yields`]).
+    pub fn hold_yielding(&mut self, i: usize, target: Vec3) {
+        self.kind[i] = ParticleFilter::Fixed { target };
+        self.any = true;
+        if self.yields.len() < self.kind.len() {
+            self.yields.resize(self.kind.len(), false);
+        }
+        self.yields[i] = true;
+    }
+
+    /// Whether particle `i` is held by a soft hold that yields to cloth–cloth contact.
+    #[inline]
+    pub fn is_yielding(&self, i: usize) -> bool {
+        self.yields.get(i).copied().unwrap_or(false)
     }
 
     /// Constrains the velocity of particle `i` along unit `normal` to `velocity`, unless the

@@ -87,6 +87,8 @@ pub struct ContactStats {
     pub ccd_hits: usize,
     /// Impact-zone rounds needed.
     pub zone_rounds: usize,
+    /// Free vertices the cloth–cloth response stopped as a last resort.
+    pub self_stopped: usize,
     /// Smallest signed distance of a cloth vertex to a body at the end of the step (m;
     /// infinite without bodies near).
     pub min_distance: f64,
@@ -544,8 +546,10 @@ impl Collisions {
                 self.inv_mass.clear();
                 // particles held by pins or bodies are not moved by cloth–cloth impulses: the
                 // free layer gives way, so nothing is pushed into a body
+                // (a compression release's hold yields: its particle is free here, so a
+                // release never carries it through another layer)
                 self.inv_mass.extend((0..n).map(|i| match filter.kind[i] {
-                    ParticleFilter::Fixed { .. } => 0.0,
+                    ParticleFilter::Fixed { .. } if !filter.is_yielding(i) => 0.0,
                     _ => 1.0 / mass[i],
                 }));
                 let rep: SelfCollisionReport = sc.respond(
@@ -564,6 +568,7 @@ impl Collisions {
                 self.stats.self_contacts = rep.proximities;
                 self.stats.ccd_hits = rep.ccd_hits;
                 self.stats.zone_rounds = rep.zone_rounds;
+                self.stats.self_stopped = rep.stopped;
             }
         }
         self.stats.collision_ms = self.ms + t0.elapsed().as_secs_f64() * 1e3;

@@ -158,7 +158,7 @@ pub fn register(engine: &mut Engine) {
             Ok(())
         });
     register!(engine, "contact_report", ["sim: Simulation", "Map"],
-        "Contact state now: #{bodies, min_distance (m, smallest signed vertex–body distance),\npenetrating (vertices inside bodies), intersections (intersecting cloth edge–triangle pairs)}\nand the last step's #{contacts, self_contacts, collision_ms}.",
+        "Contact state now: #{bodies, min_distance (m, smallest signed vertex–body distance),\npenetrating (vertices inside bodies), intersections (intersecting cloth edge–triangle pairs)}\nand the last step's #{contacts, self_contacts, ccd_hits (continuous cloth–cloth hits),\nzone_rounds (impact-zone rounds), self_stopped (vertices the cloth–cloth response stopped),\ncollision_ms}.",
         |h: &mut SimHandle| -> RResult<Map> {
             let mut sim = h.get_mut()?;
             let x = sim.state.x.clone();
@@ -171,6 +171,9 @@ pub fn register(engine: &mut Engine) {
             m.insert("intersections".into(), Dynamic::from_int(r.intersections as INT));
             m.insert("contacts".into(), Dynamic::from_int(st.contacts as INT));
             m.insert("self_contacts".into(), Dynamic::from_int(st.self_contacts as INT));
+            m.insert("ccd_hits".into(), Dynamic::from_int(st.ccd_hits as INT));
+            m.insert("zone_rounds".into(), Dynamic::from_int(st.zone_rounds as INT));
+            m.insert("self_stopped".into(), Dynamic::from_int(st.self_stopped as INT));
             m.insert("collision_ms".into(), Dynamic::from_float(st.collision_ms));
             Ok(m)
         });
