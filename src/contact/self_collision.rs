@@ -6,7 +6,9 @@
 //!    motion; each hit gets an impulse leaving the pair a quarter thickness apart; repeated;
 //! 3. **impact zones**: if hits remain, the vertices of colliding pairs are merged into zones
 //!    moved rigidly (momentum and angular momentum kept), which cannot tangle themselves;
-//!    zones grow until nothing crosses; as a last resort the remaining vertices stop.
+//!    zones grow until nothing crosses; as a last resort the zones' vertices stop, then those
+//!    of the pairs still hitting, round by round, until nothing hits or only stopped and
+//!    prescribed vertices do.
 //!
 //! Velocities change by the displacement corrections over dt. Candidate pairs come from a
 //! spatial hash of swept boxes (see [`SpatialHash`]); pairs sharing a vertex are skipped.
@@ -25,6 +27,9 @@ use crate::geometry::Vec3;
 const CCD_PASSES: usize = 6;
 /// Impact-zone rounds before the last-resort stop.
 const ZONE_ROUNDS: usize = 24;
+/// Rounds of the last resort that stop the free vertices of the pairs still hitting, before
+/// every free vertex stops.
+const STOP_ROUNDS: usize = 16;
 /// Pairs are left this fraction of the thickness apart after a continuous hit.
 const SEPARATION: f64 = 0.25;
 /// Fraction of the overlap recovered per step by the repulsion push.
@@ -519,25 +524,57 @@ impl SelfCollision {
                 self.rigidify_zones(x0, inv_mass);
             }
             if !resolved {
-                // last resort: everything in a zone stays where it was
+                // last resort: everything in a zone stays where it was; then, round by round,
+                // the free vertices of the pairs that still hit stop too. Stopping the whole
+                // cloth at once left a prescribed vertex (a held border) moving through it, and
+                // a start already tangled froze every free vertex on every step: the cloth on
+                // the cylinder at 1 mm layers stopped all 1681 vertices step after step and
+                // reached 0.69 J of stretch, with 194 crossings
                 for (_, i) in self.zone_members() {
                     if inv_mass[i as usize] > 0.0 {
                         self.d[i as usize] = Vec3::zeros();
                         rep.stopped += 1;
                     }
                 }
-                self.broad_phase(x0, pad);
-                self.find_hits(x0, thickness, &mut hits);
-                if !hits.is_empty() {
-                    // the guarantee: nothing moves, and x0 had no crossing. (Only a start that
-                    // was already tangled can get here; it then stays as it was this step.)
-                    rep.unresolved = hits.len();
+                let mut settled = false;
+                for _ in 0..STOP_ROUNDS {
+                    if self.stale(margin) {
+                        self.broad_phase(x0, pad);
+                    }
+                    self.find_hits(x0, thickness, &mut hits);
+                    if hits.is_empty() {
+                        settled = true;
+                        break;
+                    }
+                    let mut progress = false;
+                    for (k, _) in &hits {
+                        for v in self.pair_vertices(*k) {
+                            if inv_mass[v] > 0.0 && self.d[v] != Vec3::zeros() {
+                                self.d[v] = Vec3::zeros();
+                                rep.stopped += 1;
+                                progress = true;
+                            }
+                        }
+                    }
+                    if !progress {
+                        // what still hits involves only stopped or prescribed vertices: a
+                        // held vertex driven into the cloth, or a start already tangled.
+                        // Stopping more cannot help
+                        rep.unresolved = hits.len();
+                        settled = true;
+                        break;
+                    }
+                }
+                if !settled {
+                    // the guarantee for a clean start: no free vertex moves
                     rep.stopped = n;
                     for i in 0..n {
                         if inv_mass[i] > 0.0 {
                             self.d[i] = Vec3::zeros();
                         }
                     }
+                    self.find_hits(x0, thickness, &mut hits);
+                    rep.unresolved = hits.len();
                 }
             }
         }
@@ -736,6 +773,49 @@ fn swept_apart(x: &[Vec3; 4], d: &[Vec3; 4], vertex_face: bool, gap: f64) -> boo
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A held triangle driven through another held one (a clamped border pushed into cloth
+    /// that friction holds on a body) is a crossing nothing free can undo. The last resort
+    /// stopped every free vertex of the cloth then, on every step: here a free triangle a
+    /// metre away. It keeps its motion now, and the crossing is reported unresolved.
+    #[test]
+    fn held_vertices_crossing_do_not_stop_the_rest_of_the_cloth_regression() {
+        let tris = [[0, 1, 2], [3, 4, 5], [6, 7, 8]];
+        let tri = |o: Vec3| {
+            [
+                o + Vec3::new(-0.05, -0.05, 0.0),
+                o + Vec3::new(0.1, -0.05, 0.0),
+                o + Vec3::new(-0.05, 0.1, 0.0),
+            ]
+        };
+        let x0: Vec<Vec3> = [
+            tri(Vec3::new(0.0, 0.0, 0.005)),
+            tri(Vec3::new(0.01, 0.01, 0.0)),
+            tri(Vec3::new(1.0, 0.0, 0.0)),
+        ]
+        .concat();
+        let dt = 0.01;
+        // the first triangle moves 1 cm down through the second; the third drifts along x
+        let mut v: Vec<Vec3> = (0..9)
+            .map(|i| match i {
+                0..=2 => Vec3::new(0.0, 0.0, -1.0),
+                6..=8 => Vec3::new(0.3, 0.0, 0.0),
+                _ => Vec3::zeros(),
+            })
+            .collect();
+        let mut x: Vec<Vec3> = x0.iter().zip(&v).map(|(p, q)| p + q * dt).collect();
+        let inv_mass = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0];
+        let mut sc = SelfCollision::new(&tris, &x0);
+        let rep = sc.respond(&x0, &mut x, &mut v, &inv_mass, dt, 0.003, 0.0);
+        assert!(rep.unresolved > 0, "{rep:?}");
+        assert_eq!(rep.stopped, 0, "{rep:?}");
+        for i in 6..9 {
+            assert!(
+                (x[i].x - x0[i].x - 0.003).abs() < 1e-12,
+                "vertex {i} stopped: {rep:?}"
+            );
+        }
+    }
 
     /// A vertex falling onto a triangle 1 mm below it is held off, unless both lie in one
     /// pass-through zone.
