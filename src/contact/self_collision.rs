@@ -497,10 +497,7 @@ impl SelfCollision {
             self.parent.extend(0..n as u32);
             for round in 0..ZONE_ROUNDS {
                 rep.zone_rounds = round + 1;
-                if self.stale(margin) {
-                    self.broad_phase(x0, pad);
-                }
-                self.find_hits(x0, thickness, &mut hits);
+                self.refresh_hits(x0, thickness, margin, &mut hits);
                 if hits.is_empty() {
                     resolved = true;
                     break;
@@ -538,10 +535,7 @@ impl SelfCollision {
                 }
                 let mut settled = false;
                 for _ in 0..STOP_ROUNDS {
-                    if self.stale(margin) {
-                        self.broad_phase(x0, pad);
-                    }
-                    self.find_hits(x0, thickness, &mut hits);
+                    self.refresh_hits(x0, thickness, margin, &mut hits);
                     if hits.is_empty() {
                         settled = true;
                         break;
@@ -573,7 +567,7 @@ impl SelfCollision {
                             self.d[i] = Vec3::zeros();
                         }
                     }
-                    self.find_hits(x0, thickness, &mut hits);
+                    self.refresh_hits(x0, thickness, margin, &mut hits);
                     rep.unresolved = hits.len();
                 }
             }
@@ -590,6 +584,21 @@ impl SelfCollision {
             }
         }
         rep
+    }
+
+    /// The continuous hits of the current displacements, the candidates found again first if
+    /// some displacement moved more than `margin` since they were.
+    fn refresh_hits(
+        &mut self,
+        x0: &[Vec3],
+        thickness: f64,
+        margin: f64,
+        hits: &mut Vec<(usize, CcdHit)>,
+    ) {
+        if self.stale(margin) {
+            self.broad_phase(x0, thickness + margin);
+        }
+        self.find_hits(x0, thickness, hits);
     }
 
     /// Whether some displacement moved more than `margin` since the candidates were found.
