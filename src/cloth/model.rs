@@ -241,8 +241,11 @@ impl ClothModel {
     /// +490 %, 5 J of spring energy on `scripts/buckle_cylinder.rhai`). With the contact
     /// friction fixed and contacts at rest it no longer crumples, but it stores the push as in-plane
     /// shortening (5–7 % of the springs shorter by 1 %, no visible wrinkles, 0.021–0.030 J at
-    /// rest against 0.016–0.025 J without type-1 on seeds 1–8), and a perfectly flat grid
-    /// pushed in its plane keeps half its springs compressed.
+    /// rest against 0.016–0.025 J without type-1 on seeds 1–8). Since flat connections start
+    /// their arcs on a chosen side ([`super::buckling_side`]), the flat square no longer keeps
+    /// half its springs compressed with type-1, but the cloth on the cylinder still stores the
+    /// push in its plane (6.5 % of the springs compressed, 0.0265 J against 0.0139 J without a
+    /// model, seeds 1–8, 2026-12-05).
     pub fn enable_choi_ko(&mut self) {
         if self.choi_ko {
             return;
