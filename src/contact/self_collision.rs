@@ -13,13 +13,14 @@
 //! Velocities change by the displacement corrections over dt. Candidate pairs come from a
 //! spatial hash of swept boxes (see [`SpatialHash`]); pairs sharing a vertex are skipped.
 
+mod broad_phase;
+mod intersections;
+
 use rayon::prelude::*;
 
 use super::ccd::{edge_edge_ccd, vertex_face_ccd, CcdHit};
 use super::impact_zone::{find, rigid_motion, union};
-use super::primitives::{
-    closest_point_triangle, closest_points_segments, segment_triangle_intersect,
-};
+use super::primitives::{closest_point_triangle, closest_points_segments};
 use super::spatial_hash::{Aabb, SpatialHash};
 use crate::geometry::Vec3;
 
@@ -212,106 +213,6 @@ impl SelfCollision {
     /// Unique undirected edges of the cloth.
     pub fn edges(&self) -> &[[u32; 2]] {
         &self.edges
-    }
-
-    /// Candidate pairs whose boxes, swept from `x0` to `x0 + d`, come closer than `pad`.
-    fn broad_phase(&mut self, x0: &[Vec3], pad: f64) {
-        self.d_bp.clear();
-        self.d_bp.extend_from_slice(&self.d);
-        let d = &self.d;
-        let swept = |ids: &[u32], pad: f64| {
-            let mut b = Aabb::empty();
-            for &i in ids {
-                let i = i as usize;
-                b.grow(&x0[i]);
-                b.grow(&(x0[i] + d[i]));
-            }
-            b.inflated(pad)
-        };
-        self.tri_boxes.clear();
-        self.tri_boxes
-            .extend(self.triangles.iter().map(|t| swept(t, pad)));
-        self.edge_boxes.clear();
-        self.edge_boxes
-            .extend(self.edges.iter().map(|e| swept(e, 0.5 * pad)));
-        self.tri_hash.build(&self.tri_boxes, self.cell);
-        self.edge_hash.build(&self.edge_boxes, self.cell);
-        let (tris, edges) = (&self.triangles, &self.edges);
-        let (tri_hash, edge_hash, edge_boxes) = (&self.tri_hash, &self.edge_hash, &self.edge_boxes);
-        let rep = &self.welds.rep;
-        let r = |i: u32| if rep.is_empty() { i } else { rep[i as usize] };
-        let zone = &self.zone;
-        let z = |i: u32| if zone.is_empty() { 0 } else { zone[i as usize] };
-        let n = x0.len();
-        let chunk = 512;
-        let vf: Vec<Vec<(u32, u32)>> = (0..n.div_ceil(chunk))
-            .into_par_iter()
-            .map(|c| {
-                let (mut out, mut buf) = (Vec::new(), Vec::new());
-                for i in c * chunk..((c + 1) * chunk).min(n) {
-                    let mut b = Aabb::empty();
-                    b.grow(&x0[i]);
-                    b.grow(&(x0[i] + d[i]));
-                    tri_hash.query(&b, &mut buf);
-                    let iu = i as u32;
-                    let ri = r(iu);
-                    let zi = z(iu);
-                    out.extend(
-                        buf.iter()
-                            .filter(|&&t| {
-                                let t = &tris[t as usize];
-                                let shared = t.iter().any(|&k| r(k) == ri);
-                                let zoned = zi != 0 && t.iter().all(|&k| z(k) == zi);
-                                !(shared || zoned)
-                            })
-                            .map(|&t| (iu, t)),
-                    );
-                }
-                out
-            })
-            .collect();
-        let ne = edges.len();
-        let ee: Vec<Vec<(u32, u32)>> = (0..ne.div_ceil(chunk))
-            .into_par_iter()
-            .map(|c| {
-                let (mut out, mut buf) = (Vec::new(), Vec::new());
-                for e in c * chunk..((c + 1) * chunk).min(ne) {
-                    edge_hash.query(&edge_boxes[e], &mut buf);
-                    let [a, b] = edges[e];
-                    let za = if z(a) != 0 && z(a) == z(b) { z(a) } else { 0 };
-                    let (a, b) = (r(a), r(b));
-                    out.extend(
-                        buf.iter()
-                            .filter(|&&f| {
-                                let [p, q] = edges[f as usize];
-                                let zoned = za != 0 && z(p) == za && z(q) == za;
-                                let (p, q) = (r(p), r(q));
-                                f as usize > e && p != a && p != b && q != a && q != b && !zoned
-                            })
-                            .map(|&f| (e as u32, f)),
-                    );
-                }
-                out
-            })
-            .collect();
-        self.vf.clear();
-        self.vf.extend(vf.into_iter().flatten());
-        self.ee.clear();
-        self.ee.extend(ee.into_iter().flatten());
-    }
-
-    /// The four vertices of candidate `k` (vertex–face pairs first, then edge–edge).
-    #[inline]
-    fn pair_vertices(&self, k: usize) -> [usize; 4] {
-        if k < self.vf.len() {
-            let (i, t) = self.vf[k];
-            let t = self.triangles[t as usize];
-            [i as usize, t[0] as usize, t[1] as usize, t[2] as usize]
-        } else {
-            let (e, f) = self.ee[k - self.vf.len()];
-            let (e, f) = (self.edges[e as usize], self.edges[f as usize]);
-            [e[0] as usize, e[1] as usize, f[0] as usize, f[1] as usize]
-        }
     }
 
     /// Moves the displacements of `vs` so that their weighted relative displacement along `n`
@@ -700,62 +601,6 @@ impl SelfCollision {
             start = end;
         }
     }
-
-    /// Number of (edge, triangle) pairs of the cloth at `x` that intersect, pairs sharing a
-    /// vertex excluded (fast floating-point test).
-    pub fn count_intersections(&mut self, x: &[Vec3]) -> usize {
-        self.intersections(x).len()
-    }
-
-    /// The (edge, triangle) pairs of the cloth at `x` that intersect, pairs sharing a vertex
-    /// excluded (fast floating-point test), in a deterministic order.
-    pub fn intersections(&mut self, x: &[Vec3]) -> Vec<([u32; 2], [u32; 3])> {
-        let tight = |ids: &[u32]| {
-            let mut b = Aabb::empty();
-            for &i in ids {
-                b.grow(&x[i as usize]);
-            }
-            b
-        };
-        self.tri_boxes.clear();
-        self.tri_boxes
-            .extend(self.triangles.iter().map(|t| tight(t)));
-        self.tri_hash.build(&self.tri_boxes, self.cell);
-        let (tris, edges, hash) = (&self.triangles, &self.edges, &self.tri_hash);
-        let rep = &self.welds.rep;
-        let r = |i: u32| if rep.is_empty() { i } else { rep[i as usize] };
-        let ne = edges.len();
-        let chunk = 1024;
-        (0..ne.div_ceil(chunk))
-            .into_par_iter()
-            .map(|c| {
-                let mut buf = Vec::new();
-                let mut found = Vec::new();
-                for e in c * chunk..((c + 1) * chunk).min(ne) {
-                    let [a, b] = edges[e];
-                    hash.query(&tight(&[a, b]), &mut buf);
-                    for &t in &buf {
-                        let t = tris[t as usize];
-                        if t.iter().any(|&k| r(k) == r(a) || r(k) == r(b)) {
-                            continue;
-                        }
-                        let p = t.map(|i| x[i as usize]);
-                        if segment_triangle_intersect(
-                            x[a as usize],
-                            x[b as usize],
-                            p[0],
-                            p[1],
-                            p[2],
-                        ) {
-                            found.push(([a, b], t));
-                        }
-                    }
-                }
-                found
-            })
-            .flatten()
-            .collect()
-    }
 }
 
 /// Whether the boxes swept by the two primitives of a candidate over the step (from `x` by
@@ -780,91 +625,4 @@ fn swept_apart(x: &[Vec3; 4], d: &[Vec3; 4], vertex_face: bool, gap: f64) -> boo
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A held triangle driven through another held one (a clamped border pushed into cloth
-    /// that friction holds on a body) is a crossing nothing free can undo. The last resort
-    /// stopped every free vertex of the cloth then, on every step: here a free triangle a
-    /// metre away. It keeps its motion now, and the crossing is reported unresolved.
-    #[test]
-    fn held_vertices_crossing_do_not_stop_the_rest_of_the_cloth_regression() {
-        let tris = [[0, 1, 2], [3, 4, 5], [6, 7, 8]];
-        let tri = |o: Vec3| {
-            [
-                o + Vec3::new(-0.05, -0.05, 0.0),
-                o + Vec3::new(0.1, -0.05, 0.0),
-                o + Vec3::new(-0.05, 0.1, 0.0),
-            ]
-        };
-        let x0: Vec<Vec3> = [
-            tri(Vec3::new(0.0, 0.0, 0.005)),
-            tri(Vec3::new(0.01, 0.01, 0.0)),
-            tri(Vec3::new(1.0, 0.0, 0.0)),
-        ]
-        .concat();
-        let dt = 0.01;
-        // the first triangle moves 1 cm down through the second; the third drifts along x
-        let mut v: Vec<Vec3> = (0..9)
-            .map(|i| match i {
-                0..=2 => Vec3::new(0.0, 0.0, -1.0),
-                6..=8 => Vec3::new(0.3, 0.0, 0.0),
-                _ => Vec3::zeros(),
-            })
-            .collect();
-        let mut x: Vec<Vec3> = x0.iter().zip(&v).map(|(p, q)| p + q * dt).collect();
-        let inv_mass = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0];
-        let mut sc = SelfCollision::new(&tris, &x0);
-        let rep = sc.respond(&x0, &mut x, &mut v, &inv_mass, dt, 0.003, 0.0);
-        assert!(rep.unresolved > 0, "{rep:?}");
-        assert_eq!(rep.stopped, 0, "{rep:?}");
-        for i in 6..9 {
-            assert!(
-                (x[i].x - x0[i].x - 0.003).abs() < 1e-12,
-                "vertex {i} stopped: {rep:?}"
-            );
-        }
-    }
-
-    /// A vertex falling onto a triangle 1 mm below it is held off, unless both lie in one
-    /// pass-through zone.
-    #[test]
-    fn a_pass_through_zone_exempts_its_pairs() {
-        let tris = [[0, 1, 2], [3, 4, 5]];
-        let x0 = vec![
-            Vec3::new(0.0, 0.0, 0.0),
-            Vec3::new(0.1, 0.0, 0.0),
-            Vec3::new(0.0, 0.1, 0.0),
-            Vec3::new(0.02, 0.02, 0.001),
-            Vec3::new(0.12, 0.02, 0.05),
-            Vec3::new(0.02, 0.12, 0.05),
-        ];
-        let dt = 0.01;
-        let v0: Vec<Vec3> = (0..6)
-            .map(|i| {
-                if i == 3 {
-                    Vec3::new(0.0, 0.0, -0.5)
-                } else {
-                    Vec3::zeros()
-                }
-            })
-            .collect();
-        let run = |zones: &[u32]| {
-            let mut sc = SelfCollision::new(&tris, &x0);
-            sc.set_zones(zones);
-            let mut v = v0.clone();
-            let mut x: Vec<Vec3> = x0.iter().zip(&v).map(|(p, q)| p + q * dt).collect();
-            // the lower triangle is held (its motion prescribed)
-            let inv_mass = [0.0, 0.0, 0.0, 1.0, 1.0, 1.0];
-            sc.respond(&x0, &mut x, &mut v, &inv_mass, dt, 0.003, 0.0);
-            x[3].z
-        };
-        let held = run(&[]);
-        assert!(held > 0.0, "the vertex went through: z = {held}");
-        let passed = run(&[1; 6]);
-        assert!(
-            passed < 0.0,
-            "the zone did not let it through: z = {passed}"
-        );
-    }
-}
+mod tests;
