@@ -23,7 +23,10 @@ struct SourceFile {
 }
 
 fn collect_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let mut entries: Vec<_> = fs::read_dir(dir).unwrap().map(|e| e.unwrap().path()).collect();
+    let mut entries: Vec<_> = fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
     entries.sort();
     for p in entries {
         if p.is_dir() {
@@ -89,7 +92,14 @@ fn strip(src: &str) -> String {
                     if j >= b.len() {
                         break;
                     }
-                    if b[j] == b'"' && b[j + 1..].iter().take(hashes).filter(|&&h| h == b'#').count() == hashes {
+                    if b[j] == b'"'
+                        && b[j + 1..]
+                            .iter()
+                            .take(hashes)
+                            .filter(|&&h| h == b'#')
+                            .count()
+                            == hashes
+                    {
                         j += 1 + hashes;
                         break;
                     }
@@ -204,7 +214,9 @@ fn use_statements(code: &str) -> Vec<(bool, Vec<Vec<String>>)> {
         }
         let before = code[..at].trim_end();
         let is_pub = before.ends_with("pub") || before.ends_with(')') && before.contains("pub(");
-        let Some(end) = code[at..].find(';') else { break };
+        let Some(end) = code[at..].find(';') else {
+            break;
+        };
         let tree = &code[at + 4..at + end];
         // keep spaces around `as` distinguishable
         let tree = tree.replace(" as ", "@as@");
@@ -270,7 +282,12 @@ fn declared_children(code: &str) -> BTreeSet<String> {
 }
 
 /// Makes a path absolute from the module it is written in.
-fn absolute(module: &[String], is_facade_file: bool, path: &[String], children: &BTreeSet<String>) -> Option<Vec<String>> {
+fn absolute(
+    module: &[String],
+    is_facade_file: bool,
+    path: &[String],
+    children: &BTreeSet<String>,
+) -> Option<Vec<String>> {
     let first = path.first()?;
     // `self` of a non-mod file `a/b.rs` is `a::b`; `super` is `a`
     let mut base: Vec<String> = module.to_vec();
@@ -353,7 +370,15 @@ fn load_tree() -> Tree {
                 }
             }
         }
-        files.insert(module.clone(), SourceFile { module, text, children, reexports });
+        files.insert(
+            module.clone(),
+            SourceFile {
+                module,
+                text,
+                children,
+                reexports,
+            },
+        );
     }
     Tree { files }
 }
@@ -372,7 +397,9 @@ fn file_edges(tree: &Tree) -> BTreeMap<Vec<String>, BTreeSet<Vec<String>>> {
             let Some(abs) = absolute(&file.module, false, &path, &file.children) else {
                 continue;
             };
-            let Some(target) = tree.resolve(&abs, 0) else { continue };
+            let Some(target) = tree.resolve(&abs, 0) else {
+                continue;
+            };
             // the file itself, the crate root, and the file's own submodules are not edges
             if &target == module || target.is_empty() {
                 continue;
