@@ -497,7 +497,7 @@ fn describe<N: Ord + Clone>(
     msg
 }
 
-fn file_name(m: &Vec<String>) -> String {
+fn file_name(m: &[String]) -> String {
     if m.is_empty() {
         "lib".into()
     } else {
@@ -537,7 +537,7 @@ fn no_circle_between_files() {
     assert!(
         comps.is_empty(),
         "file-level circles in src/:\n{}",
-        describe(&comps, &edges, file_name)
+        describe(&comps, &edges, |m| file_name(m))
     );
 }
 
