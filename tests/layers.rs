@@ -553,3 +553,40 @@ fn the_checker_sees_a_planted_cycle() {
     assert_eq!(paths.len(), 3);
     assert_eq!(paths[0], vec!["crate", "cloth", "bcsr", "Bcsr"]);
 }
+
+/// The layer of each top-level module, bottom up (docs/architecture.md); modules of one layer
+/// may use each other as long as they make no cycle.
+const LAYERS: &[&[&str]] = &[
+    &["geometry"],
+    &["render"],
+    &["body"],
+    &["cloth"],
+    &["contact"],
+    &["garment", "kes"],
+    &["tracking", "face", "facade"],
+    &["scenes", "bench"],
+    &["script"],
+];
+
+#[test]
+fn modules_use_only_lower_layers() {
+    let rank = |m: &str| LAYERS.iter().position(|layer| layer.contains(&m));
+    let tree = load_tree();
+    let mut wrong = BTreeSet::new();
+    for (from, tos) in file_edges(&tree) {
+        let Some(a) = from.first() else { continue };
+        let ra = rank(a).unwrap_or_else(|| panic!("src/{a} has no layer in LAYERS"));
+        for to in tos {
+            let Some(b) = to.first() else { continue };
+            let rb = rank(b).unwrap_or_else(|| panic!("src/{b} has no layer in LAYERS"));
+            if rb > ra {
+                wrong.insert(format!("{} -> {}", file_name(&from), file_name(&to)));
+            }
+        }
+    }
+    assert!(
+        wrong.is_empty(),
+        "imports from a lower layer into a higher one:\n{}",
+        wrong.into_iter().collect::<Vec<_>>().join("\n")
+    );
+}
