@@ -54,9 +54,7 @@ fn dress_on_mannequin(
             .into_string()
             .map_err(|t| rt_err(format!("`makehuman` must be a string, got {t}")))?
             .into(),
-        None => std::env::var_os("EMILION_DATA")
-            .map_or_else(|| "../shared/data".into(), std::path::PathBuf::from)
-            .join("bodies/makehuman"),
+        None => crate::geometry::files::data_path("bodies/makehuman"),
     };
     let mut sp = SimulationParameters::default();
     if let Some(dt) = m.remove("dt") {
