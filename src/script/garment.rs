@@ -113,7 +113,7 @@ pub fn register(engine: &mut Engine) {
     register!(engine, "save_sheet", ["pattern: Pattern", "path: String", "()"],
         "Writes the pattern sheet (`.png` or `.svg`): the pieces side by side at 400 pixels per metre,\nnames, grain lines, notches, and each seam's two edges in its colour with its number.",
         |p: &mut PatternHandle, path: &str| -> RResult<()> {
-            crate::render::write_pattern_sheet(Path::new(path), &p.0, 400.0).map_err(rt_err)
+            crate::garment::write_pattern_sheet(Path::new(path), &p.0, 400.0).map_err(rt_err)
         });
     register!(
         engine,
