@@ -322,20 +322,6 @@ mod tests {
         fs::remove_dir_all(tmp("dir")).unwrap();
     }
 
-    #[test]
-    fn write_rejects_bad_input_without_touching_the_file() {
-        let path = tmp("bad.obj");
-        let p = [Vec3::zeros(), Vec3::x(), Vec3::y()];
-        let e = write_obj(&path, &p, &[[0, 1, 3]], None)
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("bad.obj") && e.contains("out of range"), "{e}");
-        let nan = [Vec3::zeros(), Vec3::x(), Vec3::new(f64::NAN, 0.0, 0.0)];
-        assert!(write_obj(&path, &nan, &[[0, 1, 2]], None).is_err());
-        assert!(write_obj(&path, &p, &[[0, 1, 2]], Some(&[[0.0, 0.0]])).is_err());
-        assert!(!path.exists());
-    }
-
     fn read_str(name: &str, text: &str) -> Result<TriMesh, GeometryError> {
         let path = tmp(name);
         fs::write(&path, text).unwrap();
@@ -401,5 +387,23 @@ mod tests {
         assert_eq!(m.positions.len(), 4);
         assert_eq!(m.rest[2], [2.0, 0.0]);
         assert_eq!(m.triangles, vec![[0, 1, 3], [0, 2, 3]]);
+    }
+
+    #[test]
+    fn polygons_keep_their_groups() {
+        let text = format!("{HEAD}v 1 1 0\nf 1 2 3\ng skin arm\nf 1 2 4 3\no helper\nf 2 4 3\n");
+        let obj = obj_polygons_from_text(&text, Path::new("groups.obj")).unwrap();
+        assert_eq!(obj.faces.len(), 3);
+        assert_eq!(
+            obj.faces[1]
+                .corners
+                .iter()
+                .map(|c| c[0])
+                .collect::<Vec<_>>(),
+            [0, 1, 3, 2]
+        );
+        let in_skin: Vec<bool> = obj.faces.iter().map(|f| obj.in_group(f, "skin")).collect();
+        assert_eq!(in_skin, [false, true, false]);
+        assert_eq!(obj.faces[2].line, 12);
     }
 }

@@ -217,3 +217,78 @@ pub fn write_obj(
         },
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tmp(name: &str) -> std::path::PathBuf {
+        std::env::temp_dir().join(format!("emilion-obj-write-{}-{name}", std::process::id()))
+    }
+
+    #[test]
+    fn write_rejects_bad_input_without_touching_the_file() {
+        let path = tmp("bad.obj");
+        let p = [Vec3::zeros(), Vec3::x(), Vec3::y()];
+        let e = write_obj(&path, &p, &[[0, 1, 3]], None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("bad.obj") && e.contains("out of range"), "{e}");
+        let nan = [Vec3::zeros(), Vec3::x(), Vec3::new(f64::NAN, 0.0, 0.0)];
+        assert!(write_obj(&path, &nan, &[[0, 1, 2]], None).is_err());
+        assert!(write_obj(&path, &p, &[[0, 1, 2]], Some(&[[0.0, 0.0]])).is_err());
+        assert!(!path.exists());
+    }
+
+    #[test]
+    fn groups_materials_and_own_texture_indices() {
+        let path = tmp("groups.obj");
+        let p = [
+            Vec3::zeros(),
+            Vec3::x(),
+            Vec3::y(),
+            Vec3::new(1.0, 1.0, 0.0),
+        ];
+        let comments = ["a test".to_string()];
+        let groups = [
+            ObjGroup {
+                name: Some("wall"),
+                material: Some("stone"),
+                triangles: 0..1,
+            },
+            ObjGroup {
+                name: None,
+                material: Some("glass"),
+                triangles: 1..2,
+            },
+        ];
+        let mesh = ObjMesh {
+            comments: &comments,
+            material_library: Some("groups.mtl"),
+            object: Some("facade"),
+            positions: &p,
+            uvs: &[[0.0, 0.0], [0.5, 1.0]],
+            triangles: &[[0, 1, 2], [1, 3, 2]],
+            uv_triangles: Some(&[[0, 1, 0], [1, 1, 0]]),
+            groups: &groups,
+            ..Default::default()
+        };
+        write_obj_mesh(&path, &mesh).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(
+            text,
+            "# a test\nmtllib groups.mtl\no facade\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n\
+             vt 0 0\nvt 0.5 1\ng wall\nusemtl stone\nf 1/1 2/2 3/1\nusemtl glass\nf 2/2 4/2 3/1\n"
+        );
+        let bad = ObjMesh {
+            uv_triangles: Some(&[[0, 1, 0], [1, 2, 0]]),
+            ..mesh
+        };
+        let e = write_obj_mesh(&path, &bad).unwrap_err().to_string();
+        assert!(
+            e.contains("groups.obj") && e.contains("texture coordinate"),
+            "{e}"
+        );
+        std::fs::remove_file(&path).unwrap();
+    }
+}
