@@ -33,7 +33,7 @@ fn run(script: &str, sets: &[String]) -> (bool, String, String) {
 }
 
 fn astronaut() -> PathBuf {
-    emilion::face::model::data_dir().join("images/astronaut.png")
+    emilion::geometry::files::data_dir().join("images/astronaut.png")
 }
 
 #[test]

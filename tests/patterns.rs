@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use emilion::garment::svg::parse_pattern_svg;
+use emilion::garment::formats::svg::parse_pattern_svg;
 use emilion::garment::{
     read_garment, read_pattern_json, read_pattern_svg, write_pattern_json, Copies, EdgeRef,
     Pattern, Piece, SvgOptions,

@@ -43,7 +43,8 @@ pub use retarget::{Animation, RetargetOptions};
 pub use skeleton::{Bone, Joint, Skeleton};
 pub use skinning::{Pose, SkinWeights};
 
-use crate::geometry::Vec3;
+use crate::geometry::obj::obj_polygons_from_text;
+use crate::geometry::{GeometryError, Vec3};
 use error::read_text;
 
 /// Name of the OBJ group that is the visible skin of the MakeHuman base mesh.
@@ -79,68 +80,26 @@ struct ObjBody {
     faces: Vec<Vec<usize>>,
 }
 
-/// Reads `v` lines (all groups) and the `f` lines of group `group` (0-based indices).
+/// Reads the positions (all groups, converted to the world) and the faces of group `group`
+/// (0-based position indices) of a MakeHuman OBJ file, through the geometry's OBJ reader.
 fn parse_obj(text: &str, file: &str, group: &str) -> Result<ObjBody, BodyError> {
-    let mut positions = Vec::new();
-    let mut faces = Vec::new();
-    let mut in_group = false;
-    for (i, line) in text.lines().enumerate() {
-        let ln = i + 1;
-        let mut words = line.split_whitespace();
-        match words.next() {
-            Some("v") => {
-                let mut c = [0.0; 3];
-                for x in &mut c {
-                    let w = words.next().ok_or_else(|| {
-                        BodyError::parse(file, ln, "a vertex needs 3 coordinates")
-                    })?;
-                    *x = w
-                        .parse::<f64>()
-                        .ok()
-                        .filter(|v| v.is_finite())
-                        .ok_or_else(|| {
-                            BodyError::parse(file, ln, format!("'{w}' is not a finite number"))
-                        })?;
-                }
-                positions.push(makehuman_to_world(Vec3::new(c[0], c[1], c[2])));
-            }
-            Some("g") | Some("o") => in_group = words.any(|w| w == group),
-            Some("f") if in_group => {
-                let mut face = Vec::new();
-                for w in words {
-                    let idx = w.split('/').next().unwrap_or("");
-                    let k: i64 = idx
-                        .parse()
-                        .map_err(|_| BodyError::parse(file, ln, format!("bad face index '{w}'")))?;
-                    let n = positions.len() as i64;
-                    let k = if k < 0 { n + k } else { k - 1 };
-                    if k < 0 || k >= n {
-                        return Err(BodyError::parse(
-                            file,
-                            ln,
-                            format!("face index {idx} out of range ({n} vertices so far)"),
-                        ));
-                    }
-                    face.push(k as usize);
-                }
-                if face.len() < 3 {
-                    return Err(BodyError::parse(
-                        file,
-                        ln,
-                        "a face needs at least 3 vertices",
-                    ));
-                }
-                faces.push(face);
-            }
-            _ => {}
-        }
-    }
+    let obj = obj_polygons_from_text(text, Path::new(file)).map_err(|e| match e {
+        GeometryError::Parse { line, message, .. } => BodyError::parse(file, line, message),
+        other => BodyError::invalid(file, other.to_string()),
+    })?;
+    let faces: Vec<Vec<usize>> = obj
+        .faces
+        .iter()
+        .filter(|f| obj.in_group(f, group))
+        .map(|f| f.corners.iter().map(|c| c[0]).collect())
+        .collect();
     if faces.is_empty() {
         return Err(BodyError::invalid(
             file,
             format!("no face in group '{group}'"),
         ));
     }
+    let positions = obj.positions.into_iter().map(makehuman_to_world).collect();
     Ok(ObjBody { positions, faces })
 }
 

@@ -10,20 +10,14 @@ use std::fmt::Write as _;
 use std::io::Cursor;
 use std::path::{Component, Path};
 
-use gltf_json::accessor::{ComponentType, Type};
-use gltf_json::buffer::Target;
-use gltf_json::material::{PbrBaseColorFactor, PbrMetallicRoughness, StrengthFactor};
-use gltf_json::texture::{Info, MinFilter};
-use gltf_json::{Accessor, Material};
-
 use super::error::FacadeError;
 use super::facade_mesh::{FacadeMesh, Surface};
 use super::labels::Class;
 use crate::geometry::files::write_atomic;
 use crate::geometry::gltf::{
-    f32_bounds, finish_glb, glb_accessor, glb_png_texture, glb_root, glb_triangles, glb_view,
-    linear_from_srgb,
+    linear_from_srgb, write_glb_mesh, GlbMaterial, GlbMesh, GlbPrimitive, GlbTexture,
 };
+use crate::geometry::obj::{write_obj_mesh, ObjGroup, ObjMesh};
 use crate::geometry::GeometryError;
 
 /// How a surface looks when it carries no photo (and how it reflects either way).
@@ -108,39 +102,31 @@ pub fn write_obj_mtl(
         }
     }
 
-    let mut obj =
-        String::with_capacity(40 * (mesh.positions.len() + mesh.uvs.len() + mesh.triangles.len()));
-    let _ = writeln!(
-        obj,
-        "# emilion facade mesh: metres, x right, y up, z out of the facade"
-    );
-    let _ = writeln!(obj, "mtllib {mtl_name}\no facade");
-    for p in &mesh.positions {
-        let _ = writeln!(obj, "v {} {} {}", p.x, p.y, p.z);
-    }
-    for [u, v] in &mesh.uvs {
-        let _ = writeln!(obj, "vt {} {}", u, 1.0 - v);
-    }
-    for g in &mesh.groups {
-        let name = g.surface.name();
-        let _ = writeln!(obj, "g {name}\nusemtl {name}");
-        for t in g.triangles.clone() {
-            let (p, uv) = (mesh.triangles[t], mesh.uv_triangles[t]);
-            let _ = writeln!(
-                obj,
-                "f {}/{} {}/{} {}/{}",
-                p[0] + 1,
-                uv[0] + 1,
-                p[1] + 1,
-                uv[1] + 1,
-                p[2] + 1,
-                uv[2] + 1
-            );
-        }
-    }
+    let comments = ["emilion facade mesh: metres, x right, y up, z out of the facade".to_string()];
+    let uvs: Vec<[f64; 2]> = mesh.uvs.iter().map(|&[u, v]| [u, 1.0 - v]).collect();
+    let groups: Vec<ObjGroup> = mesh
+        .groups
+        .iter()
+        .map(|g| ObjGroup {
+            name: Some(g.surface.name()),
+            material: Some(g.surface.name()),
+            triangles: g.triangles.clone(),
+        })
+        .collect();
+    let obj = ObjMesh {
+        comments: &comments,
+        material_library: Some(&mtl_name),
+        object: Some("facade"),
+        positions: &mesh.positions,
+        uvs: &uvs,
+        triangles: &mesh.triangles,
+        uv_triangles: Some(&mesh.uv_triangles),
+        groups: &groups,
+        ..Default::default()
+    };
     write_atomic(&path_mtl, |w| w.write_all(mtl.as_bytes()))
         .map_err(|e| geometry_err(&path_mtl, e))?;
-    write_atomic(path_obj, |w| w.write_all(obj.as_bytes())).map_err(|e| geometry_err(path_obj, e))
+    write_obj_mesh(path_obj, &obj).map_err(|e| geometry_err(path_obj, e))
 }
 
 /// Writes `path` as binary glTF 2.0: one scene, one node, one mesh with a primitive per group
@@ -197,88 +183,42 @@ pub fn write_glb_textured(
             indices.push(id);
         }
     }
-    let (lo, hi) = f32_bounds(&p32).map_err(invalid)?;
-
-    // Binary chunk: positions, normals, texture coordinates, indices, image; every piece is
-    // a multiple of 4 bytes long except the image, which comes last.
-    let n = p32.len() as u64;
-    let mut bin: Vec<u8> =
-        Vec::with_capacity(32 * p32.len() + 4 * indices.len() + png.as_ref().map_or(0, Vec::len));
-    let floats = p32
+    let primitives: Vec<GlbPrimitive> = mesh
+        .groups
         .iter()
-        .flatten()
-        .chain(n32.iter().flatten())
-        .chain(t32.iter().flatten());
-    floats.for_each(|c| bin.extend_from_slice(&c.to_le_bytes()));
-    indices
-        .iter()
-        .for_each(|i| bin.extend_from_slice(&i.to_le_bytes()));
-    let image_at = bin.len() as u64;
-    if let Some(bytes) = &png {
-        bin.extend_from_slice(bytes);
-    }
-
-    let (mut root, buffer) = glb_root(bin.len());
-    let view = |offset, length, target| glb_view(buffer, offset, length, target);
-    let accessor = glb_accessor;
-    let pos_view = root.push(view(0, 12 * n, Some(Target::ArrayBuffer)));
-    let nrm_view = root.push(view(12 * n, 12 * n, Some(Target::ArrayBuffer)));
-    let uv_view = root.push(view(24 * n, 8 * n, Some(Target::ArrayBuffer)));
-    let pos_acc = root.push(Accessor {
-        min: Some(serde_json::json!(lo)),
-        max: Some(serde_json::json!(hi)),
-        ..accessor(pos_view, n, ComponentType::F32, Type::Vec3)
-    });
-    let nrm_acc = root.push(accessor(nrm_view, n, ComponentType::F32, Type::Vec3));
-    let uv_acc = root.push(accessor(uv_view, n, ComponentType::F32, Type::Vec2));
-
-    let texture = png.as_ref().map(|bytes| {
-        let image_view = root.push(view(image_at, bytes.len() as u64, None));
-        glb_png_texture(&mut root, image_view, MinFilter::LinearMipmapLinear)
-    });
-
-    let mut primitives = Vec::with_capacity(mesh.groups.len());
-    for g in &mesh.groups {
-        let first = 3 * g.triangles.start as u64;
-        let count = 3 * g.triangles.len() as u64;
-        let idx_view = root.push(view(
-            32 * n + 4 * first,
-            4 * count,
-            Some(Target::ElementArrayBuffer),
-        ));
-        let idx_acc = root.push(accessor(idx_view, count, ComponentType::U32, Type::Scalar));
-        let look = appearance(g.surface);
-        let tex = texture.filter(|_| g.surface.textured());
-        let [r, gr, b] = if tex.is_some() {
-            [1.0; 3]
-        } else {
-            look.srgb.map(linear_from_srgb)
-        };
-        let material = root.push(Material {
-            pbr_metallic_roughness: PbrMetallicRoughness {
-                base_color_factor: PbrBaseColorFactor([r as f32, gr as f32, b as f32, 1.0]),
-                base_color_texture: tex.map(|index| Info {
-                    index,
-                    tex_coord: 0,
-                    extensions: None,
-                    extras: Default::default(),
+        .map(|g| {
+            let look = appearance(g.surface);
+            let textured = png.is_some() && g.surface.textured();
+            let [r, gr, b] = if textured {
+                [1.0; 3]
+            } else {
+                look.srgb.map(linear_from_srgb)
+            };
+            GlbPrimitive {
+                indices: 3 * g.triangles.start..3 * g.triangles.end,
+                material: Some(GlbMaterial {
+                    base_colour: [r as f32, gr as f32, b as f32, 1.0],
+                    textured,
+                    metallic: look.metallic as f32,
+                    roughness: look.roughness as f32,
+                    double_sided: false,
                 }),
-                metallic_factor: StrengthFactor(look.metallic as f32),
-                roughness_factor: StrengthFactor(look.roughness as f32),
-                ..Default::default()
-            },
-            ..Default::default()
-        });
-        primitives.push(glb_triangles(
-            pos_acc,
-            nrm_acc,
-            Some(uv_acc),
-            idx_acc,
-            Some(material),
-            None,
-        ));
-    }
-    finish_glb(path, root, primitives, bin).map_err(|e| geometry_err(path, e))
+            }
+        })
+        .collect();
+    let glb = GlbMesh {
+        positions: &p32,
+        normals: &n32,
+        uvs: Some(&t32),
+        indices: &indices,
+        primitives: &primitives,
+        texture: png.as_deref().map(|png| GlbTexture {
+            png,
+            mipmapped: true,
+        }),
+        ..Default::default()
+    };
+    write_glb_mesh(path, &glb).map_err(|e| geometry_err(path, e))
 }
 
 /// The bytes of a PNG file, checked to be one (signature and header decode).

@@ -13,20 +13,13 @@
 use std::io::Write;
 use std::path::Path;
 
-use gltf_json::accessor::{ComponentType, Type};
-use gltf_json::buffer::Target;
-use gltf_json::mesh::MorphTarget;
-use gltf_json::Accessor;
-
 use super::expressions::{combination, Slider};
 use super::fap::FapRig;
 use super::model::FaceMesh;
 use super::muscles::MuscleRig;
 use super::FaceError;
 use crate::geometry::files::write_atomic;
-use crate::geometry::gltf::{
-    f32_bounds, finish_glb_morph, glb_accessor, glb_root, glb_triangles, glb_view,
-};
+use crate::geometry::gltf::{write_glb_mesh, GlbMesh, GlbMorphTarget, GlbPrimitive};
 use crate::geometry::Vec3;
 
 /// The 52 ARKit blendshape names, in Apple's documented order.
@@ -196,7 +189,6 @@ pub fn write_arkit_glb(
             .collect()
     };
     let pos = f32s(&mesh.positions);
-    let (lo, hi) = f32_bounds(&pos).map_err(fail)?;
     let normals: Vec<[f32; 3]> = mesh
         .vertex_normals()
         .iter()
@@ -208,82 +200,35 @@ pub fn write_arkit_glb(
             }
         })
         .collect();
-    let mut bin: Vec<u8> = Vec::new();
-    let put3 = |bin: &mut Vec<u8>, data: &[[f32; 3]]| {
-        let at = bin.len() as u64;
-        data.iter()
-            .flatten()
-            .for_each(|c| bin.extend_from_slice(&c.to_le_bytes()));
-        at
+    let displacements: Vec<Vec<[f32; 3]>> = shapes.iter().map(|(_, d)| f32s(d)).collect();
+    let targets: Vec<GlbMorphTarget> = shapes
+        .iter()
+        .zip(&displacements)
+        .map(|((name, _), d)| GlbMorphTarget {
+            name,
+            displacements: d,
+        })
+        .collect();
+    let uvs: Vec<[f32; 2]> = mesh
+        .uvs
+        .iter()
+        .map(|uv| [uv[0] as f32, (1.0 - uv[1]) as f32])
+        .collect();
+    let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
+    let primitives = [GlbPrimitive {
+        indices: 0..indices.len(),
+        material: None,
+    }];
+    let glb = GlbMesh {
+        positions: &pos,
+        normals: &normals,
+        uvs: Some(&uvs),
+        morph_targets: &targets,
+        indices: &indices,
+        primitives: &primitives,
+        texture: None,
     };
-    let pos_at = put3(&mut bin, &pos);
-    let nrm_at = put3(&mut bin, &normals);
-    let mut target_at = Vec::with_capacity(shapes.len());
-    for (_, d) in &shapes {
-        let d32 = f32s(d);
-        let bounds = f32_bounds(&d32).map_err(fail)?;
-        target_at.push((put3(&mut bin, &d32), bounds));
-    }
-    let uv_at = bin.len() as u64;
-    for uv in &mesh.uvs {
-        bin.extend_from_slice(&(uv[0] as f32).to_le_bytes());
-        bin.extend_from_slice(&((1.0 - uv[1]) as f32).to_le_bytes());
-    }
-    let idx_at = bin.len() as u64;
-    for t in &mesh.triangles {
-        t.iter()
-            .for_each(|i| bin.extend_from_slice(&i.to_le_bytes()));
-    }
-    let (len3, nu) = (12 * n as u64, n as u64);
-    let (mut root, buffer) = glb_root(bin.len());
-    let attr = |root: &mut gltf_json::Root, at: u64, len: u64, ty: Type, target: Target| {
-        let view = root.push(glb_view(buffer, at, len, Some(target)));
-        glb_accessor(
-            view,
-            if ty == Type::Vec2 { nu } else { len / 12 },
-            ComponentType::F32,
-            ty,
-        )
-    };
-    let pos_acc = attr(&mut root, pos_at, len3, Type::Vec3, Target::ArrayBuffer);
-    let pos_acc = root.push(Accessor {
-        min: Some(serde_json::json!(lo)),
-        max: Some(serde_json::json!(hi)),
-        ..pos_acc
-    });
-    let nrm_acc = attr(&mut root, nrm_at, len3, Type::Vec3, Target::ArrayBuffer);
-    let nrm_acc = root.push(nrm_acc);
-    let uv_acc = attr(&mut root, uv_at, 8 * nu, Type::Vec2, Target::ArrayBuffer);
-    let uv_acc = root.push(uv_acc);
-    let mut targets = Vec::with_capacity(shapes.len());
-    for &(at, (tlo, thi)) in &target_at {
-        let acc = attr(&mut root, at, len3, Type::Vec3, Target::ArrayBuffer);
-        let acc = root.push(Accessor {
-            min: Some(serde_json::json!(tlo)),
-            max: Some(serde_json::json!(thi)),
-            ..acc
-        });
-        targets.push(MorphTarget {
-            positions: Some(acc),
-            normals: None,
-            tangents: None,
-        });
-    }
-    let idx_view = root.push(glb_view(
-        buffer,
-        idx_at,
-        12 * mesh.triangles.len() as u64,
-        Some(Target::ElementArrayBuffer),
-    ));
-    let idx_acc = root.push(glb_accessor(
-        idx_view,
-        3 * mesh.triangles.len() as u64,
-        ComponentType::U32,
-        Type::Scalar,
-    ));
-    let primitive = glb_triangles(pos_acc, nrm_acc, Some(uv_acc), idx_acc, None, Some(targets));
-    let names: Vec<&str> = shapes.iter().map(|(s, _)| s.as_str()).collect();
-    finish_glb_morph(path, root, vec![primitive], &names, bin).map_err(|e| fail(e.to_string()))?;
+    write_glb_mesh(path, &glb).map_err(|e| FaceError::Failed(e.to_string()))?;
     let mut csv = String::from("name,max_displacement_m,vertex\n");
     for (name, d) in &shapes {
         let (i, m) = d

@@ -386,7 +386,7 @@ impl Candide {
 
     /// The default CANDIDE-3 file under the shared data folder.
     pub fn default_path() -> PathBuf {
-        super::model::data_dir()
+        crate::geometry::files::data_dir()
             .join("faces")
             .join("candide3")
             .join("candide3.wfm")

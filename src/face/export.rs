@@ -17,19 +17,12 @@
 use std::io::Cursor;
 use std::path::Path;
 
-use gltf_json::accessor::{ComponentType, Type};
-use gltf_json::buffer::Target;
-use gltf_json::material::{PbrBaseColorFactor, PbrMetallicRoughness, StrengthFactor};
-use gltf_json::texture::{Info, MinFilter};
-use gltf_json::{Accessor, Material};
-
 use super::render::Texture;
 use super::{FaceError, FaceMesh};
 use crate::geometry::files::write_atomic;
-use crate::geometry::gltf::{
-    f32_bounds, finish_glb, glb_accessor, glb_png_texture, glb_root, glb_triangles, glb_view,
-};
-use crate::geometry::GeometryError;
+use crate::geometry::gltf::{write_glb_mesh, GlbMaterial, GlbMesh, GlbPrimitive, GlbTexture};
+use crate::geometry::obj::{write_obj_mesh, ObjGroup, ObjMesh};
+use crate::geometry::{GeometryError, Vec3};
 
 /// Name of the material in the `.mtl` file and the OBJ's `usemtl`.
 pub const MATERIAL_NAME: &str = "face";
@@ -100,14 +93,14 @@ fn check_mesh(path: &Path, mesh: &FaceMesh) -> Result<(), FaceError> {
 }
 
 /// Unit vertex normals of `mesh`, `+z` where a vertex has none (unused or degenerate).
-fn unit_normals(mesh: &FaceMesh) -> Vec<[f64; 3]> {
+fn unit_normals(mesh: &FaceMesh) -> Vec<Vec3> {
     mesh.vertex_normals()
-        .iter()
+        .into_iter()
         .map(|n| {
             if n.iter().all(|c| c.is_finite()) && (n.norm() - 1.0).abs() < 1e-6 {
-                [n.x, n.y, n.z]
+                n
             } else {
-                [0.0, 0.0, 1.0]
+                Vec3::z()
             }
         })
         .collect()
@@ -155,31 +148,32 @@ pub fn write_obj_mtl(
     })
     .map_err(|e| from_geometry(&mtl_path, e))?;
     let normals = unit_normals(mesh);
-    write_atomic(obj_path, |w| {
-        writeln!(
-            w,
-            "# emilion face: {} vertices, {} triangles, metres",
-            mesh.positions.len(),
-            mesh.triangles.len()
-        )?;
-        writeln!(w, "mtllib {mtl_name}")?;
-        for p in &mesh.positions {
-            writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
-        }
-        for t in &mesh.uvs {
-            writeln!(w, "vt {} {}", t[0], t[1])?;
-        }
-        for n in &normals {
-            writeln!(w, "vn {} {} {}", n[0], n[1], n[2])?;
-        }
-        writeln!(w, "usemtl {MATERIAL_NAME}")?;
-        for t in &mesh.triangles {
-            let [a, b, c] = t.map(|i| i + 1);
-            writeln!(w, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}")?;
-        }
-        Ok(())
-    })
-    .map_err(|e| from_geometry(obj_path, e))
+    let comments = [format!(
+        "emilion face: {} vertices, {} triangles, metres",
+        mesh.positions.len(),
+        mesh.triangles.len()
+    )];
+    let triangles: Vec<[usize; 3]> = mesh
+        .triangles
+        .iter()
+        .map(|t| t.map(|i| i as usize))
+        .collect();
+    let groups = [ObjGroup {
+        name: None,
+        material: Some(MATERIAL_NAME),
+        triangles: 0..triangles.len(),
+    }];
+    let obj = ObjMesh {
+        comments: &comments,
+        material_library: Some(&mtl_name),
+        positions: &mesh.positions,
+        uvs: &mesh.uvs,
+        normals: &normals,
+        triangles: &triangles,
+        groups: &groups,
+        ..Default::default()
+    };
+    write_obj_mesh(obj_path, &obj).map_err(|e| from_geometry(obj_path, e))
 }
 
 /// Writes `<folder>/<stem>.obj`, `<stem>.mtl` and the texture as `<stem>.png`, all in `folder`
@@ -245,78 +239,37 @@ pub fn write_glb(path: &Path, mesh: &FaceMesh, texture: &Texture) -> Result<(), 
         .iter()
         .map(|p| [p.x as f32, p.y as f32, p.z as f32])
         .collect();
-    let (lo, hi) = f32_bounds(&p32).map_err(|m| FaceError::io(path, m))?;
-    let n = mesh.positions.len() as u64;
-    let n_idx = 3 * mesh.triangles.len() as u64;
-
-    // binary chunk: positions, normals, uvs, indices (all 4-byte aligned), then the PNG
-    let mut bin = Vec::with_capacity((32 * n + 4 * n_idx) as usize + png.len());
-    let mut put = |v: f32| bin.extend_from_slice(&v.to_le_bytes());
-    p32.iter().flatten().for_each(|&c| put(c));
-    for nv in unit_normals(mesh) {
-        nv.iter().for_each(|&c| put(c as f32));
-    }
-    for uv in &mesh.uvs {
-        put(uv[0] as f32);
-        put((1.0 - uv[1]) as f32);
-    }
-    for t in &mesh.triangles {
-        t.iter()
-            .for_each(|&i| bin.extend_from_slice(&i.to_le_bytes()));
-    }
-    let (pos_at, nrm_at, uv_at, idx_at) = (0, 12 * n, 24 * n, 32 * n);
-    let png_at = idx_at + 4 * n_idx;
-    bin.extend_from_slice(&png);
-
-    let (mut root, buffer) = glb_root(bin.len());
-    let array = Some(Target::ArrayBuffer);
-    let pos_view = root.push(glb_view(buffer, pos_at, 12 * n, array));
-    let nrm_view = root.push(glb_view(buffer, nrm_at, 12 * n, array));
-    let uv_view = root.push(glb_view(buffer, uv_at, 8 * n, array));
-    let idx_view = root.push(glb_view(
-        buffer,
-        idx_at,
-        4 * n_idx,
-        Some(Target::ElementArrayBuffer),
-    ));
-    let png_view = root.push(glb_view(buffer, png_at, png.len() as u64, None));
-    let pos_acc = root.push(Accessor {
-        min: Some(serde_json::json!(lo)),
-        max: Some(serde_json::json!(hi)),
-        ..glb_accessor(pos_view, n, ComponentType::F32, Type::Vec3)
-    });
-    let nrm_acc = root.push(glb_accessor(nrm_view, n, ComponentType::F32, Type::Vec3));
-    let uv_acc = root.push(glb_accessor(uv_view, n, ComponentType::F32, Type::Vec2));
-    let idx_acc = root.push(glb_accessor(
-        idx_view,
-        n_idx,
-        ComponentType::U32,
-        Type::Scalar,
-    ));
-    let texture_index = glb_png_texture(&mut root, png_view, MinFilter::Linear);
-    let material = root.push(Material {
-        double_sided: true,
-        pbr_metallic_roughness: PbrMetallicRoughness {
-            base_color_factor: PbrBaseColorFactor([1.0, 1.0, 1.0, 1.0]),
-            base_color_texture: Some(Info {
-                index: texture_index,
-                tex_coord: 0,
-                extensions: None,
-                extras: Default::default(),
-            }),
-            metallic_factor: StrengthFactor(0.0),
-            roughness_factor: StrengthFactor(0.8),
-            ..Default::default()
-        },
+    let normals: Vec<[f32; 3]> = unit_normals(mesh)
+        .iter()
+        .map(|n| [n.x as f32, n.y as f32, n.z as f32])
+        .collect();
+    let uvs: Vec<[f32; 2]> = mesh
+        .uvs
+        .iter()
+        .map(|uv| [uv[0] as f32, (1.0 - uv[1]) as f32])
+        .collect();
+    let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
+    let primitives = [GlbPrimitive {
+        indices: 0..indices.len(),
+        material: Some(GlbMaterial {
+            base_colour: [1.0, 1.0, 1.0, 1.0],
+            textured: true,
+            metallic: 0.0,
+            roughness: 0.8,
+            double_sided: true,
+        }),
+    }];
+    let glb = GlbMesh {
+        positions: &p32,
+        normals: &normals,
+        uvs: Some(&uvs),
+        indices: &indices,
+        primitives: &primitives,
+        texture: Some(GlbTexture {
+            png: &png,
+            mipmapped: false,
+        }),
         ..Default::default()
-    });
-    let primitive = glb_triangles(
-        pos_acc,
-        nrm_acc,
-        Some(uv_acc),
-        idx_acc,
-        Some(material),
-        None,
-    );
-    finish_glb(path, root, vec![primitive], bin).map_err(|e| from_geometry(path, e))
+    };
+    write_glb_mesh(path, &glb).map_err(|e| from_geometry(path, e))
 }

@@ -9,6 +9,7 @@
 use std::path::{Path, PathBuf};
 
 use super::FaceError;
+use crate::geometry::files::data_dir;
 use crate::geometry::{read_obj, Vec3};
 
 /// Number of vertices of the MediaPipe canonical mesh.
@@ -27,11 +28,6 @@ pub const NOSE_TIP: usize = 4;
 pub const CHIN: usize = 152;
 /// Landmark of the top of the forehead.
 pub const FOREHEAD: usize = 10;
-
-/// The shared data folder (`EMILION_DATA`, default `../shared/data`).
-pub fn data_dir() -> PathBuf {
-    std::env::var_os("EMILION_DATA").map_or_else(|| "../shared/data".into(), Into::into)
-}
 
 /// The path of the MediaPipe canonical mesh under [`data_dir`].
 pub fn mediapipe_path() -> PathBuf {

@@ -28,11 +28,12 @@ use serde::{Deserialize, Serialize};
 
 use super::fap::FapRig;
 use super::head_pose::{head_pivot, HeadPose};
-use super::model::{data_dir, FaceMesh};
+use super::model::FaceMesh;
 use super::render::{FaceRenderer, Texture};
 use super::sequence_files::{write_pose_csv, PoseRow, SequenceInfo};
 use super::skin::procedural_face_texture;
 use super::FaceError;
+use crate::geometry::files::data_dir;
 use crate::geometry::{write_obj, SplitMix64, Vec3};
 use crate::tracking::camera::Camera;
 

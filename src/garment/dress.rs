@@ -6,9 +6,9 @@
 
 use std::time::Instant;
 
+use super::mesh::graph::Adjacency;
 use super::mesh::{mesh_pattern, GarmentMesh, MeshParameters};
-use super::mesh_graph::Adjacency;
-use super::preposition::{preposition, PrepositionParameters, PrepositionReport};
+use super::placement::preposition::{preposition, PrepositionParameters, PrepositionReport};
 use super::seam_hinges::seam_hinges;
 use super::{BodyFrame, Pattern, PatternError, Silhouettes};
 use crate::body::Mannequin;

@@ -1,6 +1,7 @@
-//! Helpers shared by the mesh and picture writers: atomic file writing (temporary file in the
-//! same folder, then rename), the checks a mesh must pass before it is written, and the list of
-//! the photos of a folder.
+//! Where files are and how they are written: the shared data folder ([`data_dir`]), atomic
+//! file writing (temporary file in the same folder, then rename) shared by the mesh and
+//! picture writers, the checks a mesh must pass before it is written, and the list of the
+//! photos of a folder.
 
 use std::fs;
 use std::io::{self, BufWriter, Write};
@@ -8,6 +9,17 @@ use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use super::{GeometryError, Vec3};
+
+/// The shared data folder (meshes, bodies, motion clips, photos, fabric measurements):
+/// `$EMILION_DATA`, else `../shared/data` (relative to the working directory).
+pub fn data_dir() -> std::path::PathBuf {
+    std::env::var_os("EMILION_DATA").map_or_else(|| "../shared/data".into(), Into::into)
+}
+
+/// `rel` under the shared data folder ([`data_dir`]), e.g. `data_path("bodies/makehuman")`.
+pub fn data_path(rel: impl AsRef<Path>) -> std::path::PathBuf {
+    data_dir().join(rel)
+}
 
 /// The photos of `dir` (`.png`, `.jpg`, `.jpeg`, any case), sorted by path.
 pub fn photo_files(dir: &Path) -> io::Result<Vec<std::path::PathBuf>> {

@@ -3,7 +3,7 @@
 
 pub mod cone;
 pub mod error;
-pub(crate) mod files;
+pub mod files;
 pub mod gltf;
 pub mod grid;
 pub mod mesh;

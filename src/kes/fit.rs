@@ -6,10 +6,11 @@
 //! curve point by point — until the virtual experiment reproduces the targets.
 
 use super::calibrate::{self, LawModel, TensileModel, Tests};
-use super::fabric::{FabricSpec, KesParam};
-use super::lab::{branches, measured_value, simulated_params};
+use super::fabric::FabricSpec;
+use super::kes_param::KesParam;
 use super::parameters::interp;
 use super::rig::RigMesh;
+use super::rig_parameters::{branches, measured_value, simulated_params};
 
 /// Fits the KES-parameter modes of `model` to the fabric's targets with the rigs on `mesh`.
 pub fn fit(

@@ -9,18 +9,20 @@ pub mod damping;
 pub mod error;
 pub mod fabric;
 pub mod fit;
+pub mod kes_param;
 pub mod lab;
 pub mod parameters;
 pub(crate) mod quasi_static;
 pub mod rig;
+pub mod rig_parameters;
 pub mod units;
 pub mod wang;
 
 pub use error::KesError;
 pub use fabric::{
-    read_fabric, read_fabric_dir, write_fabric, Curve, FabricCurves, FabricSpec, KesParam,
-    KesValues,
+    read_fabric, read_fabric_dir, write_fabric, Curve, FabricCurves, FabricSpec, KesValues,
 };
+pub use kes_param::KesParam;
 pub use parameters::{
     bending_parameters, shear_parameters, split_branches, tensile_parameters, BendingParams,
     ShearParams, TensileParams,

@@ -6,7 +6,7 @@
 
 use std::fmt;
 
-use super::fabric::KesParam;
+use super::kes_param::KesParam;
 
 /// Gram-force in newtons: gf → N.
 pub const GF: f64 = 9.80665e-3;

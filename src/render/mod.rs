@@ -3,13 +3,11 @@
 //! triangle rasterizer that draws [`RenderMesh`]es into an RGB image or a PNG file.
 
 pub mod camera;
-pub mod pattern_sheet;
 pub mod plot;
 pub mod raster;
 mod shading;
 
 pub use camera::Camera;
-pub use pattern_sheet::write_pattern_sheet;
 pub use plot::{
     write_plot, write_plot_pair, write_series_csv, PlotError, PlotSpec, Series, SeriesStyle,
 };

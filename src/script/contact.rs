@@ -12,6 +12,7 @@ use crate::body::RetargetOptions;
 use crate::cloth::ClothError;
 use crate::contact::character::mannequin_body;
 use crate::contact::{Body, ContactError, ContactSettings, FrictionCoefficients, MeshBody};
+use crate::geometry::files::data_path;
 use crate::geometry::{read_obj_surface, Vec3};
 
 fn contact_err(e: ContactError) -> Box<rhai::EvalAltResult> {
@@ -27,11 +28,6 @@ fn add_body(h: &SimHandle, body: Result<Body, ContactError>) -> RResult<INT> {
 
 fn v3(d: &Dynamic, what: &str) -> RResult<Vec3> {
     Ok(Vec3::from(vec3(d, what)?))
-}
-
-/// Where the shared data lives: `$EMILION_DATA`, else `../shared/data`.
-fn data_dir() -> std::path::PathBuf {
-    std::env::var_os("EMILION_DATA").map_or_else(|| "../shared/data".into(), Into::into)
 }
 
 /// Registers the contact functions of `Simulation`.
@@ -77,7 +73,7 @@ pub fn register(engine: &mut Engine) {
             let text = |k: &str| -> RResult<Option<String>> {
                 m.get(k).map(|v| v.clone().into_string().map_err(|t| rt_err(format!("`{k}` must be a string, got {t}")))).transpose()
             };
-            let dir = text("makehuman")?.map_or_else(|| data_dir().join("bodies/makehuman"), Into::into);
+            let dir = text("makehuman")?.map_or_else(|| data_path("bodies/makehuman"), Into::into);
             let motion = text("motion")?;
             let mut opt = RetargetOptions::default();
             if let Some(v) = m.get("in_place") {

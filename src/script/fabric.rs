@@ -155,7 +155,7 @@ pub fn register(engine: &mut Engine) {
         ["width: float", "height: float", "edge: float", "fabric: Fabric", "Cloth"],
         "A `width` × `height` m rectangle meshed with irregular triangles about `edge` m long (the\npattern mesher's constrained Delaunay), flat in the XY plane at z = 0, centred at the\norigin, the warp along x: a triangle-mesh cloth (hinges, no grid lines).",
         |w: Dynamic, h: Dynamic, e: Dynamic, f: Fabric| -> RResult<ClothHandle> {
-            let mesh = crate::garment::patch::rectangle_mesh(
+            let mesh = crate::garment::mesh::patch::rectangle_mesh(
                 num(&w, "width")?,
                 num(&h, "height")?,
                 num(&e, "edge")?,

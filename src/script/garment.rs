@@ -54,9 +54,7 @@ fn dress_on_mannequin(
             .into_string()
             .map_err(|t| rt_err(format!("`makehuman` must be a string, got {t}")))?
             .into(),
-        None => std::env::var_os("EMILION_DATA")
-            .map_or_else(|| "../shared/data".into(), std::path::PathBuf::from)
-            .join("bodies/makehuman"),
+        None => crate::geometry::files::data_path("bodies/makehuman"),
     };
     let mut sp = SimulationParameters::default();
     if let Some(dt) = m.remove("dt") {
@@ -115,7 +113,7 @@ pub fn register(engine: &mut Engine) {
     register!(engine, "save_sheet", ["pattern: Pattern", "path: String", "()"],
         "Writes the pattern sheet (`.png` or `.svg`): the pieces side by side at 400 pixels per metre,\nnames, grain lines, notches, and each seam's two edges in its colour with its number.",
         |p: &mut PatternHandle, path: &str| -> RResult<()> {
-            crate::render::write_pattern_sheet(Path::new(path), &p.0, 400.0).map_err(rt_err)
+            crate::garment::write_pattern_sheet(Path::new(path), &p.0, 400.0).map_err(rt_err)
         });
     register!(
         engine,

@@ -9,7 +9,7 @@ use rhai::{Dynamic, Engine, Map, INT};
 use super::convert::{count, finite, rt_err, RResult};
 use super::register;
 use crate::body::Mannequin;
-use crate::tracking::sequence::data_dir;
+use crate::geometry::files::data_path;
 use crate::tracking::sequence_files::Sequence;
 use crate::tracking::track_outputs::{arm_joints, write_track_outputs, TrackOutputOptions};
 use crate::tracking::tracker::{track_sequence, TrackerOptions};
@@ -74,7 +74,7 @@ fn options(m: &Map) -> RResult<(TrackerOptions, TrackOutputOptions, Option<Strin
 fn track(seq_dir: &str, out: &str, m: &Map) -> RResult<Map> {
     let (options, out_options, makehuman) = options(m)?;
     let seq = Sequence::open(seq_dir).map_err(rt_err)?;
-    let mh = makehuman.map_or_else(|| data_dir().join("bodies/makehuman"), Into::into);
+    let mh = makehuman.map_or_else(|| data_path("bodies/makehuman"), Into::into);
     let mannequin = Mannequin::load_makehuman(&mh).map_err(rt_err)?;
     let total = options.frames.map_or(seq.frames, |f| f.min(seq.frames));
     let bar = std::io::stderr()

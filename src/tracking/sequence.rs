@@ -58,12 +58,8 @@ use super::sequence_files::{
     cover, image_path, io_err, list_photos, write_joints_csv, write_png, JointFrame, SequenceError,
 };
 use crate::body::{Animation, BodyError, Mannequin, Motion, RetargetOptions};
+use crate::geometry::files::data_dir;
 use crate::geometry::{SplitMix64, Vec3};
-
-/// Where the shared data lives: `$EMILION_DATA`, else `../shared/data`.
-pub fn data_dir() -> PathBuf {
-    std::env::var_os("EMILION_DATA").map_or_else(|| "../shared/data".into(), Into::into)
-}
 
 /// Settings of [`make_sequence`]; see the [module docs](self) for what each does.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -148,7 +148,7 @@ fn a_release_settles_its_whole_ring_regression() {
     // three spheres bring three springs of six back to rest and stretch the others; the
     // settled destinations lower every released particle's ring strain to a fraction of it.
     use crate::cloth::FabricParameters;
-    let mesh = crate::garment::patch::rectangle_mesh(0.2, 0.1, 0.02).unwrap();
+    let mesh = crate::garment::mesh::patch::rectangle_mesh(0.2, 0.1, 0.02).unwrap();
     let mut model = ClothModel::from_mesh(mesh, FabricParameters::default()).unwrap();
     model.prestrain(-0.2, -0.05);
     let x = model.mesh.positions.clone();
@@ -182,7 +182,7 @@ fn a_flat_cloth_releases_to_one_side_at_a_time_regression() {
 #[test]
 fn a_compressed_triangle_mesh_releases_out_of_its_plane() {
     use crate::cloth::FabricParameters;
-    let mesh = crate::garment::patch::rectangle_mesh(0.2, 0.1, 0.02).unwrap();
+    let mesh = crate::garment::mesh::patch::rectangle_mesh(0.2, 0.1, 0.02).unwrap();
     let mut model = ClothModel::from_mesh(mesh, FabricParameters::default()).unwrap();
     assert!(model.grid.is_none());
     model.prestrain(-0.2, 0.0);

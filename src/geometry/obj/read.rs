@@ -1,85 +1,13 @@
-//! Wavefront OBJ files: writing a cloth's current shape (positions, rest coordinates as `vt`,
-//! vertex normals as `vn`) and reading a cloth mesh whose texture coordinates are its rest
-//! (pattern) coordinates in metres, with a small double-precision parser of the OBJ subset a
-//! mesh needs that keeps the file's vertex order and names lines in its errors.
+//! Reading Wavefront OBJ files, with a small double-precision parser of the OBJ subset a mesh
+//! needs that keeps the file's vertex order and names lines in its errors: a cloth mesh whose
+//! texture coordinates are its rest (pattern) coordinates in metres ([`read_obj`]), the
+//! surface of a collision body ([`read_obj_surface`]), or the polygons of a file with the
+//! groups they belong to ([`obj_polygons_from_text`]).
 
 use std::fs;
 use std::path::Path;
 
-use super::files::{check_mesh, write_atomic};
-use super::mesh::vertex_normals;
-use super::{GeometryError, TriMesh, Vec3};
-
-/// Writes a triangle mesh as Wavefront OBJ: `v` positions, `vt` rest coordinates (metres,
-/// when `rest` is given), `vn` area-weighted vertex normals, and `f a/a/a` faces (1-based;
-/// `f a//a` without rest coordinates). Parent folders are created; the file is written to a
-/// temporary file and renamed, so a failure never leaves a half-written file.
-///
-/// Fails, naming the file, on non-finite positions or rest coordinates, out-of-range indices,
-/// a `rest` of the wrong length, or an I/O error.
-pub fn write_obj(
-    path: &Path,
-    positions: &[Vec3],
-    triangles: &[[usize; 3]],
-    rest: Option<&[[f64; 2]]>,
-) -> Result<(), GeometryError> {
-    check_mesh(path, positions, triangles)?;
-    if let Some(rest) = rest {
-        if rest.len() != positions.len() {
-            return Err(GeometryError::Invalid(format!(
-                "{}: {} positions but {} rest coordinates",
-                path.display(),
-                positions.len(),
-                rest.len()
-            )));
-        }
-        if let Some(i) = rest.iter().position(|r| !r.iter().all(|c| c.is_finite())) {
-            return Err(GeometryError::Invalid(format!(
-                "{}: vertex {i} has a non-finite rest coordinate {:?}",
-                path.display(),
-                rest[i]
-            )));
-        }
-    }
-    let normals = vertex_normals(positions, triangles);
-    write_atomic(path, |w| {
-        writeln!(
-            w,
-            "# emilion cloth mesh: {} vertices, {} triangles",
-            positions.len(),
-            triangles.len()
-        )?;
-        if rest.is_some() {
-            writeln!(
-                w,
-                "# vt: rest (pattern) coordinates in metres, u = warp, v = weft"
-            )?;
-        }
-        for p in positions {
-            writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
-        }
-        for r in rest.unwrap_or(&[]) {
-            writeln!(w, "vt {} {}", r[0], r[1])?;
-        }
-        for n in &normals {
-            let n = if n.iter().all(|c| c.is_finite()) {
-                *n
-            } else {
-                Vec3::zeros()
-            };
-            writeln!(w, "vn {} {} {}", n.x, n.y, n.z)?;
-        }
-        for t in triangles {
-            let [a, b, c] = t.map(|i| i + 1);
-            if rest.is_some() {
-                writeln!(w, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}")?;
-            } else {
-                writeln!(w, "f {a}//{a} {b}//{b} {c}//{c}")?;
-            }
-        }
-        Ok(())
-    })
-}
+use crate::geometry::{GeometryError, TriMesh, Vec3};
 
 /// Reads a cloth mesh from a Wavefront OBJ file. The texture coordinates are the rest
 /// (pattern) coordinates in metres, so every face corner needs one (`f 1/1 2/2 3/3`); each
@@ -164,10 +92,84 @@ fn read_and_parse(path: &Path, need_uv: bool) -> Result<(TriMesh, Vec<usize>), G
 /// Why texture coordinates are required.
 const NEEDS_UV: &str = "a cloth mesh needs texture coordinates (vt) as rest coordinates in metres";
 
-/// Parses OBJ text into a mesh and, per triangle, the 1-based line of its face. Errors carry
-/// the 1-based line and a message. Without `need_uv`, texture coordinates are ignored (every
-/// corner takes a zero rest coordinate, so vertices are never split at UV seams).
+/// The polygons of an OBJ file as written (not triangulated), with the `g`/`o` names they
+/// were declared under.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ObjPolygons {
+    /// Vertex positions, in `v` order (divided by their optional w).
+    pub positions: Vec<Vec3>,
+    /// Texture coordinates, in `vt` order.
+    pub uvs: Vec<[f64; 2]>,
+    /// The faces, in file order.
+    pub faces: Vec<ObjFace>,
+    /// The names of each `g` or `o` line, in file order.
+    pub group_names: Vec<Vec<String>>,
+}
+
+/// One face (`f` line) of an [`ObjPolygons`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ObjFace {
+    /// Corners: 0-based (position, texture coordinate); the texture coordinate is 0 where
+    /// texture coordinates were not asked for.
+    pub corners: Vec<[usize; 2]>,
+    /// 1-based line of the face.
+    pub line: usize,
+    /// The last `g` or `o` line before it (index into [`ObjPolygons::group_names`]).
+    pub group: Option<usize>,
+}
+
+impl ObjPolygons {
+    /// Whether `face` is in the group or object `name` (named on the last `g`/`o` line before it).
+    pub fn in_group(&self, face: &ObjFace, name: &str) -> bool {
+        face.group
+            .is_some_and(|g| self.group_names[g].iter().any(|n| n == name))
+    }
+}
+
+/// The polygons of OBJ text already in memory; `path` names it in errors. Texture
+/// coordinates and normals are checked but not required; errors as [`read_obj`] (file and
+/// line).
+pub fn obj_polygons_from_text(text: &str, path: &Path) -> Result<ObjPolygons, GeometryError> {
+    parse_polygons(text, false).map_err(|(line, message)| parse_error(path, line, message))
+}
+
+/// Parses OBJ text into a mesh and, per triangle, the 1-based line of its face (polygons
+/// split into triangle fans). Errors carry the 1-based line and a message. Without `need_uv`,
+/// texture coordinates are ignored (every corner takes a zero rest coordinate, so vertices
+/// are never split at UV seams).
 fn parse(text: &str, need_uv: bool) -> Result<(TriMesh, Vec<usize>), (usize, String)> {
+    let obj = parse_polygons(text, need_uv)?;
+    // Per triangle corner: (position, texture coordinate), 0-based.
+    let mut corners: Vec<[usize; 2]> = Vec::new();
+    let mut face_lines = Vec::new();
+    for face in &obj.faces {
+        let c = &face.corners;
+        for k in 1..c.len() - 1 {
+            corners.extend([c[0], c[k], c[k + 1]]);
+            face_lines.push(face.line);
+        }
+    }
+    // One vertex per distinct (position, texture coordinate), in that order.
+    let mut keys = corners.clone();
+    keys.sort_unstable();
+    keys.dedup();
+    let mesh = TriMesh {
+        positions: keys.iter().map(|k| obj.positions[k[0]]).collect(),
+        rest: keys
+            .iter()
+            .map(|k| if need_uv { obj.uvs[k[1]] } else { [0.0, 0.0] })
+            .collect(),
+        triangles: corners
+            .chunks_exact(3)
+            .map(|c| [0, 1, 2].map(|j| keys.binary_search(&c[j]).unwrap_or_default()))
+            .collect(),
+    };
+    Ok((mesh, face_lines))
+}
+
+/// Parses OBJ text into its polygons. Errors carry the 1-based line and a message. Without
+/// `need_uv`, face corners need no texture coordinate (and take 0).
+fn parse_polygons(text: &str, need_uv: bool) -> Result<ObjPolygons, (usize, String)> {
     let mut total = [0usize; 3];
     for line in text.lines() {
         match line.split_whitespace().next() {
@@ -177,12 +179,12 @@ fn parse(text: &str, need_uv: bool) -> Result<(TriMesh, Vec<usize>), (usize, Str
             _ => {}
         }
     }
-    let mut positions = Vec::with_capacity(total[0]);
-    let mut uvs = Vec::with_capacity(total[1]);
+    let mut obj = ObjPolygons {
+        positions: Vec::with_capacity(total[0]),
+        uvs: Vec::with_capacity(total[1]),
+        ..Default::default()
+    };
     let mut normals = 0;
-    // Per triangle corner: (position, texture coordinate), 0-based.
-    let mut corners: Vec<[usize; 2]> = Vec::new();
-    let mut face_lines = Vec::new();
     for (i, line) in text.lines().enumerate() {
         let ln = i + 1;
         let mut words = line.split_whitespace();
@@ -191,8 +193,12 @@ fn parse(text: &str, need_uv: bool) -> Result<(TriMesh, Vec<usize>), (usize, Str
             Some("v") => (3, "vertex position"),
             Some("vt") => (2, "texture coordinate"),
             Some("vn") => (3, "normal"),
+            Some("g") | Some("o") => {
+                obj.group_names.push(words.map(str::to_string).collect());
+                continue;
+            }
             Some("f") => {
-                let seen = [positions.len(), uvs.len(), normals];
+                let seen = [obj.positions.len(), obj.uvs.len(), normals];
                 let face = words
                     .map(|c| corner(c, &seen, &total, need_uv))
                     .collect::<Result<Vec<_>, _>>();
@@ -203,10 +209,11 @@ fn parse(text: &str, need_uv: bool) -> Result<(TriMesh, Vec<usize>), (usize, Str
                         format!("face needs at least 3 corners: `{}`", line.trim()),
                     ));
                 }
-                for k in 1..face.len() - 1 {
-                    corners.extend([face[0], face[k], face[k + 1]]);
-                    face_lines.push(ln);
-                }
+                obj.faces.push(ObjFace {
+                    corners: face,
+                    line: ln,
+                    group: obj.group_names.len().checked_sub(1),
+                });
                 continue;
             }
             _ => continue,
@@ -224,28 +231,14 @@ fn parse(text: &str, need_uv: bool) -> Result<(TriMesh, Vec<usize>), (usize, Str
                 if w == 0.0 {
                     return Err((ln, format!("vertex position has w = 0: `{}`", line.trim())));
                 }
-                positions.push(Vec3::new(values[0], values[1], values[2]) / w);
+                obj.positions
+                    .push(Vec3::new(values[0], values[1], values[2]) / w);
             }
-            Some("vt") => uvs.push([values[0], values[1]]),
+            Some("vt") => obj.uvs.push([values[0], values[1]]),
             _ => normals += 1,
         }
     }
-    // One vertex per distinct (position, texture coordinate), in that order.
-    let mut keys = corners.clone();
-    keys.sort_unstable();
-    keys.dedup();
-    let mesh = TriMesh {
-        positions: keys.iter().map(|k| positions[k[0]]).collect(),
-        rest: keys
-            .iter()
-            .map(|k| if need_uv { uvs[k[1]] } else { [0.0, 0.0] })
-            .collect(),
-        triangles: corners
-            .chunks_exact(3)
-            .map(|c| [0, 1, 2].map(|j| keys.binary_search(&c[j]).unwrap_or_default()))
-            .collect(),
-    };
-    Ok((mesh, face_lines))
+    Ok(obj)
 }
 
 /// Resolves one face corner `v/vt[/vn]` to 0-based (position, texture coordinate) indices,
@@ -304,6 +297,7 @@ fn corner(
 mod tests {
     use super::*;
     use crate::geometry::grid_mesh;
+    use crate::geometry::obj::write_obj;
 
     fn tmp(name: &str) -> std::path::PathBuf {
         std::env::temp_dir().join(format!("emilion-obj-{}-{name}", std::process::id()))
@@ -326,20 +320,6 @@ mod tests {
         let left: Vec<_> = fs::read_dir(path.parent().unwrap()).unwrap().collect();
         assert_eq!(left.len(), 1);
         fs::remove_dir_all(tmp("dir")).unwrap();
-    }
-
-    #[test]
-    fn write_rejects_bad_input_without_touching_the_file() {
-        let path = tmp("bad.obj");
-        let p = [Vec3::zeros(), Vec3::x(), Vec3::y()];
-        let e = write_obj(&path, &p, &[[0, 1, 3]], None)
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("bad.obj") && e.contains("out of range"), "{e}");
-        let nan = [Vec3::zeros(), Vec3::x(), Vec3::new(f64::NAN, 0.0, 0.0)];
-        assert!(write_obj(&path, &nan, &[[0, 1, 2]], None).is_err());
-        assert!(write_obj(&path, &p, &[[0, 1, 2]], Some(&[[0.0, 0.0]])).is_err());
-        assert!(!path.exists());
     }
 
     fn read_str(name: &str, text: &str) -> Result<TriMesh, GeometryError> {
@@ -407,5 +387,23 @@ mod tests {
         assert_eq!(m.positions.len(), 4);
         assert_eq!(m.rest[2], [2.0, 0.0]);
         assert_eq!(m.triangles, vec![[0, 1, 3], [0, 2, 3]]);
+    }
+
+    #[test]
+    fn polygons_keep_their_groups() {
+        let text = format!("{HEAD}v 1 1 0\nf 1 2 3\ng skin arm\nf 1 2 4 3\no helper\nf 2 4 3\n");
+        let obj = obj_polygons_from_text(&text, Path::new("groups.obj")).unwrap();
+        assert_eq!(obj.faces.len(), 3);
+        assert_eq!(
+            obj.faces[1]
+                .corners
+                .iter()
+                .map(|c| c[0])
+                .collect::<Vec<_>>(),
+            [0, 1, 3, 2]
+        );
+        let in_skin: Vec<bool> = obj.faces.iter().map(|f| obj.in_group(f, "skin")).collect();
+        assert_eq!(in_skin, [false, true, false]);
+        assert_eq!(obj.faces[2].line, 12);
     }
 }

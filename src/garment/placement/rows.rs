@@ -3,11 +3,11 @@
 //! sections (widened where the garment row is longer), and the placement of a figurine point
 //! on its row's shell.
 
-use super::mesh::GarmentMesh;
-use super::preposition::{s_of, Figurine};
+use super::figurine::{s_of, Figurine};
 use super::shell::Shell;
 use super::silhouette::{Landmarks, Silhouettes};
-use super::{Side, P2};
+use crate::garment::mesh::GarmentMesh;
+use crate::garment::{Side, P2};
 
 /// One piece's horizontal interval in one row: (piece, X0, X1, group).
 #[derive(Clone, Copy)]

@@ -20,8 +20,8 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::dxf::geom::{add, bezier, closest_on_loop, cross, dist, mul, signed_area, sub};
-use super::error::PatternError;
-use super::pattern::{Copies, Pattern, Piece, Segment, P2};
+use crate::garment::error::PatternError;
+use crate::garment::pattern::{Copies, Pattern, Piece, Segment, P2};
 
 /// Largest distance from a flattened curve to its chords (m).
 const FLATTEN_TOL: f64 = 5e-5;

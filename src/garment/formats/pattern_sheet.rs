@@ -7,9 +7,11 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::plot::{error, register_embedded_font, series_colour, write_atomic, FONT_FAMILY};
-use super::PlotError;
 use crate::garment::{Pattern, P2};
+use crate::render::plot::{
+    error, register_embedded_font, series_colour, write_atomic, FONT_FAMILY,
+};
+use crate::render::PlotError;
 
 /// Gap between pieces on the sheet (m).
 const GAP: f64 = 0.05;

@@ -4,17 +4,17 @@
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
-use super::P2;
+use crate::garment::P2;
 
 /// Vertex adjacency of a triangle mesh (compressed rows).
-pub(super) struct Adjacency {
+pub(crate) struct Adjacency {
     start: Vec<usize>,
     next: Vec<usize>,
 }
 
 impl Adjacency {
     /// The adjacency of `triangles` over `n` vertices.
-    pub(super) fn new(triangles: &[[usize; 3]], n: usize) -> Adjacency {
+    pub(crate) fn new(triangles: &[[usize; 3]], n: usize) -> Adjacency {
         let mut pairs: Vec<(usize, usize)> = triangles
             .iter()
             .flat_map(|t| {
@@ -37,14 +37,14 @@ impl Adjacency {
     }
 
     /// The vertices sharing an edge with `v`.
-    pub(super) fn neighbours(&self, v: usize) -> &[usize] {
+    pub(crate) fn neighbours(&self, v: usize) -> &[usize] {
         &self.next[self.start[v]..self.start[v + 1]]
     }
 
     /// Shortest path lengths (in the 2D embedding `pos`) from `sources` along mesh edges, up
     /// to `limit`, and each reached vertex's nearest source (unreached vertices: distance
     /// infinite, nearest `usize::MAX`).
-    pub(super) fn nearest(
+    pub(crate) fn nearest(
         &self,
         sources: &[usize],
         pos: &[P2],

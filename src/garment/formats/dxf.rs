@@ -12,7 +12,7 @@
 //!   14 or a `Piece Name:` text. With no such block, the ENTITIES section is one piece; with
 //!   piece blocks, boundary geometry outside them is an error.
 //! - Piece system text (TEXT/MTEXT): `Piece Name: X` names the piece (else the block name);
-//!   `Quantity: N` gives [`Copies::Pair`](super::Copies::Pair) for even N ≥ 2, else `One`.
+//!   `Quantity: N` gives [`Copies::Pair`](crate::garment::Copies::Pair) for even N ≥ 2, else `One`.
 //!   Style system text: `Style Name:` names the pattern (else the file stem); `Units: ENGLISH`
 //!   (inches) or `METRIC` (mm), also `CM`, `M`; without it `$INSUNITS`; without both,
 //!   millimetres.
@@ -55,8 +55,8 @@ use std::path::Path;
 use ::dxf::entities::{Entity, EntityType};
 use ::dxf::{Drawing, DxfError};
 
-use super::error::PatternError;
-use super::pattern::{Pattern, Piece};
+use crate::garment::error::PatternError;
+use crate::garment::pattern::{Pattern, Piece};
 use piece::{build, collect, Xf};
 
 /// Entity types allowed on AAMA layers.

@@ -49,8 +49,8 @@
 
 use std::path::Path;
 
-use super::error::PatternError;
-use super::pattern::Pattern;
+use crate::garment::error::PatternError;
+use crate::garment::pattern::Pattern;
 
 /// Reads a JSON pattern file, sets `source` to its path, turns clockwise outlines round and
 /// validates the pattern.

@@ -20,16 +20,17 @@
 use std::time::Instant;
 
 use super::centre_seams::{lay_centre_seams, CentreEdge};
+use super::figurine::{figurines, Figurine};
 use super::hierarchy::interpolate;
 use super::layers::{layer_lifts, mean_edge_length};
-use super::mesh::GarmentMesh;
-use super::mesh::{mesh_pattern, MeshParameters};
 use super::over_the_top::{column_tops, over_the_top, over_the_top_lifts};
 use super::relax::{push_out, relax};
 use super::rows::Rows;
 use super::silhouette::{Landmarks, Silhouettes};
-use super::{Pattern, PatternError, Side, P2};
 use crate::contact::MeshBody;
+use crate::garment::mesh::GarmentMesh;
+use crate::garment::mesh::{mesh_pattern, MeshParameters};
+use crate::garment::{Pattern, PatternError, Side, P2};
 use crate::geometry::Vec3;
 
 /// Settings of the pre-positioning.
@@ -81,25 +82,6 @@ pub struct PrepositionReport {
     pub min_distance: f64,
     /// Wall time (s).
     pub seconds: f64,
-}
-
-/// The figurine (front or back view) transform of a piece: flat point ↦ (X, height).
-pub(super) struct Figurine {
-    pub(super) side: Side,
-    rot: [f64; 4],
-    anchor: P2,
-    pub(super) at: P2,
-}
-
-impl Figurine {
-    fn apply(&self, p: &P2) -> P2 {
-        let (x, y) = (p[0] - self.anchor[0], p[1] - self.anchor[1]);
-        let r = &self.rot;
-        [
-            self.at[0] + r[0] * x + r[1] * y,
-            self.at[1] + r[2] * x + r[3] * y,
-        ]
-    }
 }
 
 /// Distance (m) along a piece over which the displacement that lays a centre seam on the
@@ -399,72 +381,4 @@ pub fn edge_strain(garment: &GarmentMesh, x: &[Vec3]) -> (f64, f64) {
         }
     }
     (sum / count.max(1) as f64, max)
-}
-
-/// Each piece's figurine transform from its placement.
-fn figurines(
-    pattern: &Pattern,
-    garment: &GarmentMesh,
-    marks: &Landmarks,
-) -> Result<Vec<Figurine>, PatternError> {
-    garment
-        .pieces
-        .iter()
-        .map(|pm| {
-            let err = |message: String| PatternError::Piece {
-                source_name: pattern.source.clone(),
-                piece: pm.name.clone(),
-                message,
-            };
-            let piece = pattern
-                .pieces
-                .iter()
-                .find(|p| p.name == pm.name)
-                .ok_or_else(|| err("not in the pattern".into()))?;
-            let pl = piece
-                .placement
-                .as_ref()
-                .ok_or_else(|| err("has no placement: pre-positioning needs one".into()))?;
-            let level = marks.get(&pl.level).ok_or_else(|| {
-                err(format!(
-                    "placement level '{}' is not a landmark (neck, shoulder, chest, armpit, waist, hip, crotch, knee, ankle)",
-                    pl.level
-                ))
-            })?;
-            let anchor = pm
-                .corners
-                .iter()
-                .find(|(name, _)| *name == pl.anchor)
-                .map(|&(_, v)| garment.flat[v])
-                .ok_or_else(|| err(format!("placement anchor corner '{}' not found", pl.anchor)))?;
-            let g = [
-                piece.grain[1][0] - piece.grain[0][0],
-                piece.grain[1][1] - piece.grain[0][1],
-            ];
-            // the smallest turn that makes the grain vertical
-            let mut phi = std::f64::consts::FRAC_PI_2 - g[1].atan2(g[0]);
-            while phi > std::f64::consts::FRAC_PI_2 {
-                phi -= std::f64::consts::PI;
-            }
-            while phi <= -std::f64::consts::FRAC_PI_2 {
-                phi += std::f64::consts::PI;
-            }
-            let (c, s) = (phi.cos(), phi.sin());
-            Ok(Figurine {
-                side: pl.side,
-                rot: [c, -s, s, c],
-                anchor,
-                at: [pl.x, level + pl.dz],
-            })
-        })
-        .collect()
-}
-
-/// Left coordinate of a figurine X on a side.
-#[inline]
-pub(super) fn s_of(side: Side, x: f64) -> f64 {
-    match side {
-        Side::Front => x,
-        Side::Back => -x,
-    }
 }

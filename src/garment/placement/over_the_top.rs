@@ -3,10 +3,10 @@
 //! laid over the top towards the other side (the seed's 3D silhouette), and how far pieces
 //! must rise for their shoulder seams to meet there.
 
-use super::mesh::GarmentMesh;
-use super::preposition::{s_of, Figurine};
+use super::figurine::{s_of, Figurine};
 use super::silhouette::{Landmarks, Silhouettes};
-use super::{Side, P2};
+use crate::garment::mesh::GarmentMesh;
+use crate::garment::{Side, P2};
 
 /// How far each piece must rise so that the seams joining a front piece to a back piece over
 /// the top of the body (shoulder seams) meet when both are laid over the top

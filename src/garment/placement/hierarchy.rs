@@ -4,8 +4,8 @@
 //! fine garment by barycentric interpolation in the pattern plane, so the fine relaxation sweeps
 //! only have short-wavelength strain left to remove.
 
-use super::mesh::GarmentMesh;
-use super::P2;
+use crate::garment::mesh::GarmentMesh;
+use crate::garment::P2;
 use crate::geometry::Vec3;
 
 /// The field `delta` given on the vertices of `coarse` (the same pattern, meshed coarser),

@@ -4,7 +4,7 @@
 //!
 //! This module owns the triangulation of a piece's interior and the assembly of the
 //! [`GarmentMesh`]; the boundary sampling (seam edges at common arc-length fractions) lives in
-//! `mesh_boundary`. How a piece is meshed: its sampled outline, rotated so the grain line is
+//! [`boundary`]. How a piece is meshed: its sampled outline, rotated so the grain line is
 //! +u, is the constraint loop of a constrained Delaunay triangulation (spade); the interior is
 //! seeded with a hexagonal lattice aligned with the warp (rows along the grain), kept at least
 //! 0.6 edge length from the boundary; the lattice vertices near the boundary are smoothed
@@ -12,6 +12,10 @@
 //! again, then refined (spade's Delaunay refinement) for the minimum angle and the area with
 //! the constraint edges kept whole, so that the boundary vertices are exactly the sampled ones
 //! and seam pairs stay one to one.
+
+pub(crate) mod boundary;
+pub(crate) mod graph;
+pub mod patch;
 
 use std::ops::Range;
 
@@ -21,8 +25,8 @@ use spade::{
     AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,
 };
 
+use self::boundary::{plan, source_name, Curve};
 use super::error::PatternError;
-use super::mesh_boundary::{plan, source_name, Curve};
 use super::pattern::{Copies, Pattern, Piece, P2};
 use crate::geometry::{TriMesh, Vec3};
 

@@ -5,9 +5,9 @@
 //! lifted away from the body by a layer gap, ramped down with the distance (along the piece)
 //! from the overlap so the piece is not sheared.
 
-use super::mesh::GarmentMesh;
-use super::mesh_graph::Adjacency;
-use super::{Side, P2};
+use crate::garment::mesh::graph::Adjacency;
+use crate::garment::mesh::GarmentMesh;
+use crate::garment::{Side, P2};
 
 /// Lift (m, outwards) of every garment vertex so that overlapping pieces form layers.
 ///

@@ -1,7 +1,7 @@
 //! SVG `transform` lists (matrix, translate, scale, rotate, skewX, skewY) as 2D affine maps.
 
-use super::pattern::P2;
-use super::svg_path::parse_numbers;
+use super::path::parse_numbers;
+use crate::garment::pattern::P2;
 
 /// A 2D affine map `[a, b, c, d, e, f]`: (x, y) ↦ (a x + c y + e, b x + d y + f), as SVG's
 /// `matrix(a b c d e f)`.

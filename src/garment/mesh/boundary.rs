@@ -1,4 +1,4 @@
-//! Boundary sampling for meshing ([`super::mesh`]): the outline of every piece cut into boundary
+//! Boundary sampling for meshing ([`crate::garment::mesh`]): the outline of every piece cut into boundary
 //! vertices at the target edge length, with the two edges of each seam sampled at the same
 //! arc-length fractions (corner to corner where both edges have corners at nearly the same
 //! place) so that their vertices pair one to one.
@@ -6,8 +6,8 @@
 //! Owns its own Bézier evaluation and arc-length parameterisation (dense chord tables), the
 //! planning of seam fractions, and the check that a sampled outline is a simple polygon.
 
-use super::error::PatternError;
-use super::pattern::{Pattern, Piece, Segment, P2};
+use crate::garment::error::PatternError;
+use crate::garment::pattern::{Pattern, Piece, Segment, P2};
 
 /// Chords per cubic in the arc-length table.
 const TABLE: usize = 512;

@@ -2,9 +2,9 @@
 //! triangles, the warp along x): the triangle-mesh counterpart of a grid cloth, for experiments
 //! that must not depend on a grid's regular lines.
 
-use super::error::PatternError;
-use super::mesh::{mesh_pattern, MeshParameters};
-use super::pattern::{Copies, Corner, Outline, Pattern, Piece, Segment};
+use crate::garment::error::PatternError;
+use crate::garment::mesh::{mesh_pattern, MeshParameters};
+use crate::garment::pattern::{Copies, Corner, Outline, Pattern, Piece, Segment};
 use crate::geometry::TriMesh;
 
 /// A `width` × `height` m rectangle meshed with triangles about `edge_length` m long, flat in

@@ -35,10 +35,10 @@ use std::path::Path;
 
 use serde::{Deserialize, Deserializer, Serialize};
 
-use super::error::PatternError;
 use super::json::json_error;
-use super::pattern::{Copies, Pattern, Placement, Seam};
 use super::svg::{parse_pattern_svg, SvgOptions};
+use crate::garment::error::PatternError;
+use crate::garment::pattern::{Copies, Pattern, Placement, Seam};
 
 /// One used part of the SVG.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

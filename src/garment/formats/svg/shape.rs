@@ -2,9 +2,9 @@
 //! (merged corners, straight cubics as lines), and the markings read off a piece: fold edge,
 //! grain orientation, default grain, seam allowance.
 
-use super::pattern::{Corner, Outline, Segment, P2};
-use super::svg_path::{PathSeg, SubPath};
+use super::path::{PathSeg, SubPath};
 use super::xml::Element;
+use crate::garment::pattern::{Corner, Outline, Segment, P2};
 
 pub(super) fn num_attr(el: &Element, name: &str) -> f64 {
     el.attr(name).and_then(length_number).unwrap_or(0.0)

@@ -2,7 +2,7 @@
 //! lines and cubic Béziers (quadratics are raised, arcs split into cubics of at most 90°) in
 //! user units.
 
-use super::pattern::P2;
+use crate::garment::pattern::P2;
 
 /// One drawing step of a sub-path.
 #[derive(Debug, Clone, Copy, PartialEq)]

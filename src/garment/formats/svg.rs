@@ -26,18 +26,26 @@
 //! merged, cubics whose control points lie on their chord become lines, the outline is made
 //! counter-clockwise keeping the path's start as `c0`, and corners are named `c0, c1, …` in
 //! that order. Other elements are ignored.
+//!
+//! The pieces of the reader are submodules: `xml` (the document), `path` (path data),
+//! `transform` (transform lists) and `shape` (basic shapes and markings).
+
+mod path;
+mod shape;
+mod transform;
+mod xml;
 
 use std::path::Path;
 
-use super::error::PatternError;
-use super::pattern::{Pattern, Piece, P2};
-use super::svg_path::{parse_path, SubPath};
-use super::svg_shape::{
+use self::path::{parse_path, SubPath};
+use self::shape::{
     default_grain, dist, extent, fold_corner, infer_allowance, num_attr, orient_up, outline_of,
     polygon, rect,
 };
-use super::svg_transform::{parse_transform, Affine};
-use super::xml::{self, Element};
+use self::transform::{parse_transform, Affine};
+use self::xml::Element;
+use crate::garment::error::PatternError;
+use crate::garment::pattern::{Pattern, Piece, P2};
 
 /// How an SVG file is read.
 #[derive(Debug, Clone, PartialEq)]

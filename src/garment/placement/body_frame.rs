@@ -3,7 +3,7 @@
 //! symmetry plane) and the front axis (smallest spread). Signs come from the body's shape: the
 //! lowest slab holds two feet and the highest one head; the toes point forward of the shins.
 
-use super::PatternError;
+use crate::garment::PatternError;
 use crate::geometry::{Mat3, Vec3};
 
 /// An orthonormal frame attached to a standing body, with `left = up × front`.

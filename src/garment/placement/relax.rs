@@ -1,8 +1,8 @@
 //! Relaxation of a pre-positioned garment: Jacobi sweeps towards the rest edge lengths (the
 //! stretch part of the cloth's energy, minimised locally) that keep the skin clear.
 
-use super::mesh::GarmentMesh;
 use crate::contact::MeshBody;
+use crate::garment::mesh::GarmentMesh;
 use crate::geometry::Vec3;
 
 /// Moves vertices closer to the skin than half the clearance out to the clearance, along the

@@ -6,10 +6,10 @@
 //! up the back, grown by the clearance), and the rest of the two pieces follows with a
 //! displacement that fades with the distance along the piece from the seam.
 
-use super::mesh::GarmentMesh;
-use super::mesh_graph::Adjacency;
 use super::shell::convex_hull;
-use super::{Side, P2};
+use crate::garment::mesh::graph::Adjacency;
+use crate::garment::mesh::GarmentMesh;
+use crate::garment::{Side, P2};
 use crate::geometry::Vec3;
 
 /// The centre profile: the body's outline in its plane of symmetry (height, depth), grown by

@@ -5,7 +5,7 @@
 //! (crotch, hip, waist, armpit/chest, shoulder, neck, knee, ankle).
 
 use super::body_frame::BodyFrame;
-use super::PatternError;
+use crate::garment::PatternError;
 use crate::geometry::Vec3;
 
 /// Front and back depth maps of a body on a grid of `cell`-sized squares.
