@@ -31,10 +31,10 @@ use super::head_pose::{head_pivot, HeadPose};
 use super::model::FaceMesh;
 use super::samples::SurfaceSamples;
 use super::FaceError;
+use crate::geometry::Camera;
 use crate::geometry::{SplitMix64, Vec3};
+use crate::render::raster::{draw_triangles, project_vertices, RasterTarget};
 use crate::tracking::annealing::{anneal, AnnealScratch, AnnealSettings};
-use crate::tracking::camera::Camera;
-use crate::tracking::raster::{draw_triangles, project_vertices, RasterTarget};
 use image::RgbImage;
 
 /// Settings of the face tracker.

@@ -48,8 +48,8 @@ use super::landmarks::{
 };
 use super::model::{FaceMesh, MEDIAPIPE_VERTICES};
 use super::FaceError;
+use crate::geometry::Camera;
 use crate::geometry::Vec3;
-use crate::tracking::camera::Camera;
 
 /// One photo of the face: its 68 iBUG landmarks in crate pixel coordinates (top-left pixel
 /// centre at `(0, 0)`; subtract [`super::landmarks::PTS_PIXEL_ORIGIN`] from `.pts` values)

@@ -1,6 +1,8 @@
 //! Geometry: triangle meshes with rest (pattern) coordinates, grid generators, edge/hinge
-//! adjacency, and mesh file I/O (OBJ read/write, binary glTF write).
+//! adjacency, mesh file I/O (OBJ read/write, binary glTF write), and the pinhole camera
+//! ([`camera`]).
 
+pub mod camera;
 pub mod cone;
 pub mod error;
 pub(crate) mod files;
@@ -11,6 +13,7 @@ pub mod obj;
 pub mod random;
 pub mod topology;
 
+pub use camera::{Camera, LookAtCamera};
 pub use error::GeometryError;
 pub use files::photo_files;
 pub use gltf::write_glb;
