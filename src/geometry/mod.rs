@@ -1,6 +1,6 @@
 //! Geometry: triangle meshes with rest (pattern) coordinates, grid generators, edge/hinge
-//! adjacency, mesh file I/O (OBJ read/write, binary glTF write), and the pinhole camera
-//! ([`camera`]).
+//! adjacency, mesh file I/O (OBJ read/write, binary glTF write), the pinhole camera
+//! ([`camera`]), and the Levenberg–Marquardt solver ([`least_squares`]).
 
 pub mod camera;
 pub mod cone;
@@ -8,6 +8,7 @@ pub mod error;
 pub(crate) mod files;
 pub mod gltf;
 pub mod grid;
+pub mod least_squares;
 pub mod mesh;
 pub mod obj;
 pub mod random;

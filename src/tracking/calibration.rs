@@ -6,7 +6,7 @@
 //!    non-coplanar points, ignoring distortion;
 //! 2. [`decompose_projection`]: an RQ decomposition `P = λ K [R | t]` with positive focal lengths
 //!    and `det R = +1` (the skew of `K` is dropped, the camera model has none);
-//! 3. a hand-written Levenberg–Marquardt refinement of `fx, fy, cx, cy, k1, k2`, the rotation
+//! 3. a Levenberg–Marquardt refinement (the damping of [`crate::geometry::least_squares`]) of `fx, fy, cx, cy, k1, k2`, the rotation
 //!    (as an axis-angle increment composed on the left of the current rotation) and the
 //!    translation, minimising the squared pixel reprojection error with a central-difference
 //!    Jacobian and Nielsen's damping update.
@@ -17,6 +17,7 @@ use nalgebra::{DMatrix, Matrix3, Rotation3, SMatrix, SVector, Vector3};
 
 pub use super::correspondences::{CalibrationError, MIN_POINTS};
 pub use super::dlt::{decompose_projection, dlt, KRt};
+use crate::geometry::least_squares::{Damping, DampingUpdate, DiagonalDamping};
 use crate::geometry::Camera;
 
 /// Number of refined parameters: fx, fy, cx, cy, k1, k2, ω (3), t (3).
@@ -171,8 +172,15 @@ pub fn calibrate_with(
         .filter(|&i| options.estimate_distortion || !(i == 4 || i == 5))
         .collect();
 
-    let mut mu = -1.0;
-    let mut nu = 2.0;
+    // Nielsen's damping; λ set from the first Jacobian
+    let mut damping = Damping::new(
+        -1.0,
+        DiagonalDamping::Clamped {
+            floor: 1e-12,
+            extra: 0.0,
+        },
+        DampingUpdate::Nielsen,
+    );
     let mut iterations = 0;
     let mut converged = false;
     let mut jac = DMatrix::<f64>::zeros(2 * n, NPARAM);
@@ -222,11 +230,11 @@ pub fn calibrate_with(
                 converged = true;
                 break;
             }
-            if mu < 0.0 {
-                mu = 1e-3 * active.iter().map(|&c| jtj[(c, c)]).fold(0.0, f64::max);
+            if damping.lambda < 0.0 {
+                damping.lambda = 1e-3 * active.iter().map(|&c| jtj[(c, c)]).fold(0.0, f64::max);
             }
         }
-        // damped normal equations on the active parameters (Marquardt scaling)
+        // damped normal equations on the active parameters (Marquardt scaling, floor 1e-12)
         let m = active.len();
         let mut a = DMatrix::<f64>::zeros(m, m);
         let mut b = nalgebra::DVector::<f64>::zeros(m);
@@ -234,16 +242,10 @@ pub fn calibrate_with(
             for (ib, &cb) in active.iter().enumerate() {
                 a[(ia, ib)] = jtj[(ca, cb)];
             }
-            a[(ia, ia)] += mu * jtj[(ca, ca)].max(1e-12);
-            b[ia] = -g[ca];
+            b[ia] = g[ca];
         }
-        let step = match a.cholesky() {
-            Some(ch) => ch.solve(&b),
-            None => {
-                mu *= nu;
-                nu *= 2.0;
-                continue;
-            }
+        let Some(step) = damping.solve(&a, &b) else {
+            continue;
         };
         let mut delta = Params::zeros();
         for (ia, &ca) in active.iter().enumerate() {
@@ -280,17 +282,15 @@ pub fn calibrate_with(
             let rel = (cost - cost_new) / cost.max(1e-300);
             res = res_new;
             cost = cost_new;
-            mu *= (1.0f64 / 3.0).max(1.0 - (2.0 * rho - 1.0).powi(3));
-            nu = 2.0;
+            damping.accept(rho);
             need_jacobian = true;
             if cost == 0.0 || rel < 1e-15 && delta.norm() <= 1e-9 * (xnorm + 1e-9) {
                 converged = true;
                 break;
             }
         } else {
-            mu *= nu;
-            nu *= 2.0;
-            if !mu.is_finite() {
+            damping.reject();
+            if !damping.lambda.is_finite() {
                 break;
             }
         }
