@@ -201,7 +201,9 @@ impl Damping {
         loop {
             match tries {
                 Tries::Count(n) if count >= n => return false,
-                Tries::WhileBelow(max) if !(self.lambda < max) => return false,
+                Tries::WhileBelow(max) if self.lambda >= max || self.lambda.is_nan() => {
+                    return false
+                }
                 _ => {}
             }
             count += 1;
@@ -418,14 +420,17 @@ mod tests {
         );
         let a = nalgebra::Matrix2::new(2.0, 0.0, 0.0, 2.0);
         let g = nalgebra::Vector2::new(-4.0, 0.0);
-        // λ = 1: (2 + 2) δ = 4
         let mut seen = Vec::new();
         let ok = d.try_steps(&a, &g, Tries::Count(3), |delta| {
             seen.push(delta[0]);
             Attempt::Rejected
         });
         assert!(!ok);
-        assert_eq!(seen, [1.0, 0.4, 4.0 / 34.0]);
+        // λ = 1, 4, 16: δ = 4 / (2 + 2λ)
+        assert_eq!(seen.len(), 3);
+        for (d, e) in seen.iter().zip([1.0, 0.4, 4.0 / 34.0]) {
+            assert!((d - e).abs() < 1e-15, "{seen:?}");
+        }
         assert_eq!(d.lambda, 64.0);
         assert!(d.try_steps(&a, &g, Tries::Count(1), |_| Attempt::Accepted {
             gain_ratio: 1.0
