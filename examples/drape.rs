@@ -4,7 +4,8 @@
 //! `cargo run --release --example drape -- [n] [self]`
 
 use emilion::geometry::mesh::bounds;
-use emilion::render::{render_png, Camera, RenderMesh};
+use emilion::geometry::LookAtCamera;
+use emilion::render::{render_png, RenderMesh};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
@@ -67,7 +68,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             sphere_t.push([b, b + nu, a + nu]);
         }
     }
-    let cam = Camera::look_at(
+    let cam = LookAtCamera::look_at(
         emilion::geometry::Vec3::new(1.2, -1.6, 1.1),
         emilion::geometry::Vec3::new(0.0, 0.0, 0.0),
     );

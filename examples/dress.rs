@@ -19,8 +19,9 @@ use emilion::body::Mannequin;
 use emilion::cloth::{FabricParameters, SimulationParameters};
 use emilion::contact::Shape;
 use emilion::garment::{dress, read_garment, DressParameters};
+use emilion::geometry::LookAtCamera;
 use emilion::geometry::Vec3;
-use emilion::render::{render_png, Camera, RenderMesh};
+use emilion::render::{render_png, RenderMesh};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
@@ -343,7 +344,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     color: [200, 190, 170],
                 },
             ],
-            &Camera::look_at(eye, target),
+            &LookAtCamera::look_at(eye, target),
         )?;
         println!("wrote {path}");
     }
@@ -387,7 +388,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             render_png(
                 Path::new(&path),
                 &meshes,
-                &Camera::look_at(target + eye, target),
+                &LookAtCamera::look_at(target + eye, target),
             )?;
             println!("wrote {path}");
         }

@@ -5,8 +5,9 @@
 use std::path::PathBuf;
 
 use emilion::cloth::{stats, ClothModel, FabricParameters, Simulation, SimulationParameters};
+use emilion::geometry::LookAtCamera;
 use emilion::geometry::{mesh::bounds, write_glb, write_obj};
-use emilion::render::{render_png, Camera, RenderMesh};
+use emilion::render::{render_png, RenderMesh};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = PathBuf::from(
@@ -29,7 +30,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?;
     write_glb(&out.join("hang.glb"), &sim.state.x, tris)?;
     let (lo, hi) = bounds(&sim.state.x);
-    let camera = Camera::framing(lo, hi, 800, 600);
+    let camera = LookAtCamera::framing(lo, hi, 800, 600);
     let mesh = RenderMesh {
         positions: &sim.state.x,
         triangles: tris,

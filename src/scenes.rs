@@ -12,9 +12,10 @@ use crate::cloth::{
 };
 use crate::contact::Body;
 use crate::geometry::mesh::bounds;
+use crate::geometry::LookAtCamera;
 use crate::geometry::Vec3;
 use crate::geometry::{write_glb, write_obj};
-use crate::render::{render_png, Camera, RenderMesh};
+use crate::render::{render_png, RenderMesh};
 
 /// The peer benchmark scene: a 1 m × 1 m grid of `n` × `n` particles flat in the XY plane at
 /// z = 0, the two corners of the y = +0.5 edge pinned, gravity −9.81 m/s² along z, cotton-like
@@ -95,7 +96,7 @@ pub fn demo(out_dir: &Path) -> Result<Vec<PathBuf>, ClothError> {
         triangles: tris,
         color: RenderMesh::DEFAULT_COLOR,
     };
-    render_png(&png, &[mesh], &Camera::framing(lo, hi, 800, 600))?;
+    render_png(&png, &[mesh], &LookAtCamera::framing(lo, hi, 800, 600))?;
     let obj = out_dir.join("demo.obj");
     write_obj(&obj, x, tris, Some(&sim.model.mesh.rest))?;
     let glb = out_dir.join("demo.glb");

@@ -4,8 +4,8 @@
 
 use std::path::PathBuf;
 
+use emilion::geometry::camera::{Camera, CameraError};
 use emilion::tracking::calibration::{calibrate, dlt, Calibration, CalibrationError};
-use emilion::tracking::camera::{Camera, CameraError};
 use nalgebra::{Rotation3, Vector3};
 
 /// Deterministic SplitMix64 generator with uniform and Gaussian draws.
@@ -310,7 +310,7 @@ fn invalid_rotation_and_focal_are_rejected() {
     let mut cam = true_camera();
     cam.fx = -3.0;
     let path = tmp_path("neg_focal.json");
-    let file: emilion::tracking::camera::CameraFile = (&cam).into();
+    let file: emilion::geometry::camera::JsonCamera = (&cam).into();
     std::fs::write(&path, serde_json::to_string(&file).expect("ser")).expect("write");
     let msg = Camera::load(&path).expect_err("negative focal").to_string();
     assert!(

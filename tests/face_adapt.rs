@@ -20,8 +20,8 @@ use emilion::face::rbf::{deform, kernel, ControlPoint, Rbf};
 use emilion::face::regions::{landmark_region, FaceRegions, Region};
 use emilion::face::view_fit::View;
 use emilion::face::{FaceError, FaceMesh};
+use emilion::geometry::Camera;
 use emilion::geometry::{SplitMix64, Vec3};
-use emilion::tracking::camera::Camera;
 use nalgebra::Matrix3;
 
 fn generic() -> FaceMesh {

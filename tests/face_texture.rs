@@ -14,8 +14,8 @@ use emilion::face::texture_bake::{
     bake_texture, bake_texture_with, rasterize_uv, BakeOptions, UvTexel,
 };
 use emilion::face::FaceMesh;
+use emilion::geometry::Camera;
 use emilion::geometry::Vec3;
-use emilion::tracking::camera::Camera;
 use image::{Rgb, RgbImage};
 use nalgebra::Matrix3;
 

@@ -6,11 +6,11 @@
 use std::path::{Path, PathBuf};
 
 use emilion::body::bvh::{bvh_to_world, Motion};
+use emilion::geometry::Camera;
 use emilion::geometry::Vec3;
 use emilion::tracking::bvh_export::{
     to_bvh_string, write_bvh, write_joints_csv, TrackingOutputError,
 };
-use emilion::tracking::camera::Camera;
 use emilion::tracking::joints::{joint_index, JOINT_COUNT, TRACKING_JOINTS};
 use emilion::tracking::overlay::{
     broadcast_frame, draw_skeleton, draw_skeleton_styled, write_overlay_png, SkeletonStyle,

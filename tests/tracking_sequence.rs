@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use emilion::body::{Animation, Mannequin, Motion, RetargetOptions};
-use emilion::tracking::camera::Camera;
+use emilion::geometry::Camera;
 use emilion::tracking::joints::{JointSet, JOINT_COUNT};
 use emilion::tracking::sequence::{make_sequence, SequenceOptions};
 use emilion::tracking::sequence_files::Sequence;
@@ -357,8 +357,8 @@ fn same_seed_same_bytes() {
 
 #[test]
 fn rasterizer_speed_and_rigid_skinning() {
+    use emilion::render::raster::{draw_triangles, project_vertices, RasterTarget};
     use emilion::tracking::clothing::{clothing_colours, shaded_colours};
-    use emilion::tracking::raster::{draw_triangles, project_vertices, RasterTarget};
     let seq = Sequence::open(base()).unwrap();
     let anim = animation();
     let m = anim.mannequin();

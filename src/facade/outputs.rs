@@ -19,8 +19,9 @@ use super::labels::{Class, LabelMap};
 use super::overlay;
 use super::parse::rasterize;
 use super::segments;
+use crate::geometry::LookAtCamera;
 use crate::geometry::Vec3;
-use crate::render::{render_png, Camera, RenderMesh};
+use crate::render::{render_png, RenderMesh};
 
 /// Storey height (m) a floor of the parse stands for when the facade is built in 3D.
 pub const STOREY_M: f64 = 3.2;
@@ -95,7 +96,7 @@ pub fn render_facade(path: &Path, mesh: &FacadeMesh) -> Result<(), FacadeError> 
     let fit = (size.y / (0.5 * fov.to_radians()).tan())
         .max(size.x / (0.5 * fov.to_radians()).tan() * height as f64 / width as f64)
         * 0.6;
-    let camera = Camera {
+    let camera = LookAtCamera {
         eye: center + Vec3::new(0.35, 0.2, 1.0).normalize() * (fit + size.z),
         target: center,
         up: Vec3::y(),

@@ -39,8 +39,8 @@ use super::view_fit::{
     ViewFitOptions,
 };
 use super::FaceError;
+use crate::geometry::Camera;
 use crate::geometry::Vec3;
-use crate::tracking::camera::Camera;
 
 /// Settings of the adaptation.
 #[derive(Clone, Debug, PartialEq)]

@@ -17,8 +17,8 @@
 
 use super::landmarks::is_contour;
 use super::model::FaceMesh;
+use crate::geometry::Camera;
 use crate::geometry::Vec3;
-use crate::tracking::camera::Camera;
 
 /// One visible contour edge and its projection.
 #[derive(Clone, Debug, PartialEq)]

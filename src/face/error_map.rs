@@ -20,10 +20,10 @@ use plotters::prelude::*;
 use rayon::prelude::*;
 
 use super::{FaceError, FaceMesh};
+use crate::geometry::Camera;
 use crate::geometry::Vec3;
 use crate::render::plot::{register_embedded_font, FONT_FAMILY};
-use crate::tracking::camera::Camera;
-use crate::tracking::raster::{draw_triangles, project_vertices, RasterTarget};
+use crate::render::raster::{draw_triangles, project_vertices, RasterTarget};
 
 /// Height in pixels of the legend strip [`error_map_image`] adds below the render.
 pub const LEGEND_HEIGHT: u32 = 48;

@@ -9,9 +9,9 @@ use super::model::FaceMesh;
 use super::render::{FaceRenderer, Texture};
 use super::skin::procedural_face_texture;
 use super::FaceError;
+use crate::geometry::Camera;
 use crate::geometry::Vec3;
-use crate::tracking::camera::Camera;
-use crate::tracking::raster::{draw_triangles, project_vertices, RasterTarget};
+use crate::render::raster::{draw_triangles, project_vertices, RasterTarget};
 
 /// A camera looking at `mesh`'s centroid from `yaw_deg` (0: in front), framing the face in a
 /// `width × height` image.

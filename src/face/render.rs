@@ -1,7 +1,7 @@
 //! Textured, z-buffered rendering of a face mesh through a [`Camera`], and the texture image.
 //!
 //! [`FaceRenderer::render`] reuses the tracker's rasterizer
-//! ([`crate::tracking::raster::draw_triangles`]): texture coordinates travel
+//! ([`crate::render::raster::draw_triangles`]): texture coordinates travel
 //! as the interpolated "colour" of each vertex (affine in the image, which for a face's small
 //! triangles differs from perspective-correct interpolation by far less than a texel), then
 //! every covered pixel samples the [`Texture`] bilinearly. The result stays in the renderer's
@@ -16,9 +16,9 @@ use std::path::Path;
 use image::{Rgb, RgbImage};
 
 use super::FaceError;
+use crate::geometry::Camera;
 use crate::geometry::Vec3;
-use crate::tracking::camera::Camera;
-use crate::tracking::raster::{draw_triangles, project_vertices, RasterTarget};
+use crate::render::raster::{draw_triangles, project_vertices, RasterTarget};
 
 /// An RGB texture, linear 0..255 floats, row 0 at the top of the image (`v = 1`).
 #[derive(Clone, Debug, PartialEq)]

@@ -34,8 +34,8 @@ use super::sequence_files::{write_pose_csv, PoseRow, SequenceInfo};
 use super::skin::procedural_face_texture;
 use super::FaceError;
 use crate::geometry::files::data_dir;
+use crate::geometry::Camera;
 use crate::geometry::{write_obj, SplitMix64, Vec3};
-use crate::tracking::camera::Camera;
 
 /// Settings of [`make_face_sequence`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

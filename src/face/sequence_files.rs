@@ -10,8 +10,8 @@ use super::head_pose::HeadPose;
 use super::model::FaceMesh;
 use super::sequence::FaceSequenceOptions;
 use super::FaceError;
+use crate::geometry::Camera;
 use crate::geometry::Vec3;
-use crate::tracking::camera::Camera;
 
 /// The description of a sequence (`sequence.json`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -35,9 +35,9 @@ use rayon::prelude::*;
 
 use super::render::Texture;
 use super::{FaceError, FaceMesh};
+use crate::geometry::Camera;
 use crate::geometry::Vec3;
-use crate::tracking::camera::Camera;
-use crate::tracking::raster::{draw_triangles, project_vertices, RasterTarget, NEAR};
+use crate::render::raster::{draw_triangles, project_vertices, RasterTarget, NEAR};
 
 /// Largest texture side accepted by the baker, texels.
 pub const MAX_TEXTURE_SIZE: usize = 4096;

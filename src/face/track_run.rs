@@ -248,7 +248,7 @@ pub fn write_face_track_outputs(
 /// Draws the posed mesh's edges (thin, green) on `img`.
 fn draw_mesh(
     img: &mut image::RgbImage,
-    cam: &crate::tracking::camera::Camera,
+    cam: &crate::geometry::Camera,
     pose: &HeadPose,
     pivot: &crate::geometry::Vec3,
     vertices: &[crate::geometry::Vec3],

@@ -31,10 +31,11 @@ use super::head_pose::{head_pivot, HeadPose};
 use super::model::FaceMesh;
 use super::samples::SurfaceSamples;
 use super::FaceError;
+use crate::geometry::least_squares::{Attempt, Damping, DampingUpdate, DiagonalDamping, Tries};
+use crate::geometry::Camera;
 use crate::geometry::{SplitMix64, Vec3};
+use crate::render::raster::{draw_triangles, project_vertices, RasterTarget};
 use crate::tracking::annealing::{anneal, AnnealScratch, AnnealSettings};
-use crate::tracking::camera::Camera;
-use crate::tracking::raster::{draw_triangles, project_vertices, RasterTarget};
 use image::RgbImage;
 
 /// Settings of the face tracker.
@@ -552,7 +553,7 @@ impl FaceTracker {
     /// Gauss–Newton (Levenberg-damped) on the rigid pose at `level`.
     fn gauss_newton(&mut self, level: usize, iterations: usize) {
         let s2 = self.options.robust_sigma.powi(2);
-        let mut lambda = 1e-3;
+        let mut damping = pose_damping(1e-9, 0.0);
         self.pose_samples();
         let mut current = self.rigid_cost(level).0;
         for _ in 0..iterations {
@@ -579,16 +580,7 @@ impl FaceTracker {
                 }
             }
             let saved = self.pose;
-            let mut improved = false;
-            for _ in 0..4 {
-                let mut hd = h;
-                for k in 0..6 {
-                    hd[(k, k)] += lambda * h[(k, k)].max(1e-9);
-                }
-                let Some(delta) = hd.cholesky().map(|c| c.solve(&(-b))) else {
-                    lambda *= 10.0;
-                    continue;
-                };
+            let improved = damping.try_steps(&h, &b, Tries::Count(4), |delta| {
                 self.pose = saved.perturbed(
                     &Vec3::new(delta[0], delta[1], delta[2]),
                     &Vec3::new(delta[3], delta[4], delta[5]),
@@ -597,13 +589,11 @@ impl FaceTracker {
                 let c = self.rigid_cost(level).0;
                 if c < current {
                     current = c;
-                    lambda = (lambda / 3.0).max(1e-6);
-                    improved = true;
-                    break;
+                    return Attempt::Accepted { gain_ratio: 1.0 };
                 }
-                lambda *= 10.0;
                 self.pose = saved;
-            }
+                Attempt::Rejected
+            });
             if !improved {
                 self.pose_samples();
                 break;
@@ -621,7 +611,7 @@ impl FaceTracker {
             return;
         }
         let s2 = self.options.robust_sigma.powi(2);
-        let mut lambda = 1e-3;
+        let mut damping = pose_damping(1e-12, 1e-12);
         self.pose_samples();
         let mut current = self.rigid_cost(level).0;
         let mut h = nalgebra::DMatrix::<f64>::zeros(n, n);
@@ -659,16 +649,7 @@ impl FaceTracker {
                 }
             }
             let saved: Vec<f64> = self.tracked.iter().map(|&i| self.faps[i]).collect();
-            let mut improved = false;
-            for _ in 0..4 {
-                let mut hd = h.clone();
-                for k in 0..n {
-                    hd[(k, k)] += lambda * h[(k, k)].max(1e-12) + 1e-12;
-                }
-                let Some(delta) = hd.cholesky().map(|c| c.solve(&(-&b))) else {
-                    lambda *= 10.0;
-                    continue;
-                };
+            let improved = damping.try_steps(&h, &b, Tries::Count(4), |delta| {
                 for (k, (&i, (lo, hi))) in self.tracked.iter().zip(&self.ranges).enumerate() {
                     self.faps[i] = (saved[k] + delta[k]).clamp(*lo, *hi);
                 }
@@ -676,15 +657,13 @@ impl FaceTracker {
                 let c = self.rigid_cost(level).0;
                 if c < current {
                     current = c;
-                    lambda = (lambda / 3.0).max(1e-6);
-                    improved = true;
-                    break;
+                    return Attempt::Accepted { gain_ratio: 1.0 };
                 }
-                lambda *= 10.0;
                 for (k, &i) in self.tracked.iter().enumerate() {
                     self.faps[i] = saved[k];
                 }
-            }
+                Attempt::Rejected
+            });
             if !improved {
                 self.pose_samples();
                 break;
@@ -877,4 +856,20 @@ impl FaceTracker {
     pub fn posed_vertices(&self) -> &[Vec3] {
         &self.posed
     }
+}
+
+/// The damping of the tracker's Gauss–Newton passes: `λ max(H_kk, floor) + extra` on the
+/// diagonal, `λ` from 1e-3, divided by 3 (not below 1e-6) after an accepted step, times 10
+/// after a rejected one or a failed factorisation.
+fn pose_damping(floor: f64, extra: f64) -> Damping {
+    Damping::new(
+        1e-3,
+        DiagonalDamping::Clamped { floor, extra },
+        DampingUpdate::Factors {
+            down: 3.0,
+            min: 1e-6,
+            up: 10.0,
+            singular: 10.0,
+        },
+    )
 }

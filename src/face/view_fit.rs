@@ -41,15 +41,18 @@
 //! Jacobians are forward differences; the damping is Marquardt's (scaled diagonal). Nothing
 //! panics on bad input: [`validate_views`] names the view and the point at fault.
 
-use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, SMatrix, Vector2};
+use nalgebra::{Matrix3, Rotation3, SMatrix, Vector2};
 
 use super::landmarks::{
     is_central, is_contour, landmark_positions, IBUG68_MIRROR, IBUG68_TO_MEDIAPIPE, IBUG_POINTS,
 };
 use super::model::{FaceMesh, MEDIAPIPE_VERTICES};
 use super::FaceError;
+use crate::geometry::least_squares::{
+    self, DampingUpdate, DiagonalDamping, ForwardDifferences, Schedule, Tries,
+};
+use crate::geometry::Camera;
 use crate::geometry::Vec3;
-use crate::tracking::camera::Camera;
 
 /// One photo of the face: its 68 iBUG landmarks in crate pixel coordinates (top-left pixel
 /// centre at `(0, 0)`; subtract [`super::landmarks::PTS_PIXEL_ORIGIN`] from `.pts` values)
@@ -236,9 +239,13 @@ pub fn landmark_normals(mesh: &FaceMesh) -> Vec<Vec3> {
         .collect()
 }
 
-/// Dense Levenberg–Marquardt on a state `S` moved by `apply(state, delta)`, with a forward-
-/// difference Jacobian of step `steps[k]` per parameter. Returns the state, its cost (half
-/// the squared residual norm) and the iterations done.
+/// Dense Levenberg–Marquardt ([`least_squares::minimize`]) on a state `S` moved by
+/// `apply(state, delta)`, with a forward-difference Jacobian of step `steps[k]` per parameter;
+/// Marquardt's damping shifted by 1e-9 of the largest diagonal entry, `λ` from 1e-3, divided
+/// by 3 (not below 1e-12) after an accepted step, times 4 after a rejected one, times 10 when
+/// the damped system is not positive definite, tried while below 1e12; stops when a step
+/// gains less than 1e-10 of the cost. Returns the state, its cost (half the squared residual
+/// norm) and the iterations done.
 pub(crate) fn levenberg_marquardt<S: Clone>(
     start: S,
     steps: &[f64],
@@ -246,57 +253,28 @@ pub(crate) fn levenberg_marquardt<S: Clone>(
     residual: &dyn Fn(&S) -> Vec<f64>,
     iterations: usize,
 ) -> (S, f64, usize) {
-    let np = steps.len();
-    let mut state = start;
-    let mut r = DVector::from_vec(residual(&state));
-    let mut cost = 0.5 * r.norm_squared();
-    let mut lambda = 1e-3;
-    let mut done = 0;
-    let mut delta = vec![0.0; np];
-    for it in 0..iterations {
-        done = it + 1;
-        let m = r.len();
-        let mut jac = DMatrix::zeros(m, np);
-        for k in 0..np {
-            delta.iter_mut().for_each(|d| *d = 0.0);
-            delta[k] = steps[k];
-            let rk = residual(&apply(&state, &delta));
-            for i in 0..m {
-                jac[(i, k)] = (rk[i] - r[i]) / steps[k];
-            }
-        }
-        let a = jac.tr_mul(&jac);
-        let g = jac.tr_mul(&r);
-        let scale = a.diagonal().max().max(1e-300);
-        let mut improved = false;
-        while lambda < 1e12 {
-            let mut damped = a.clone();
-            for k in 0..np {
-                damped[(k, k)] += lambda * (a[(k, k)] + 1e-9 * scale);
-            }
-            let Some(step) = damped.cholesky().map(|c| c.solve(&(-&g))) else {
-                lambda *= 10.0;
-                continue;
-            };
-            let cand = apply(&state, step.as_slice());
-            let rc = DVector::from_vec(residual(&cand));
-            let cc = 0.5 * rc.norm_squared();
-            if cc.is_finite() && cc < cost {
-                let rel = (cost - cc) / cost.max(1e-300);
-                state = cand;
-                r = rc;
-                cost = cc;
-                lambda = (lambda / 3.0).max(1e-12);
-                improved = rel > 1e-10;
-                break;
-            }
-            lambda *= 4.0;
-        }
-        if !improved {
-            break;
-        }
-    }
-    (state, cost, done)
+    let mut problem = ForwardDifferences {
+        steps,
+        apply,
+        residual,
+    };
+    let schedule = Schedule {
+        iterations,
+        damping: (
+            1e-3,
+            DiagonalDamping::ShiftedRelative { relative: 1e-9 },
+            DampingUpdate::Factors {
+                down: 3.0,
+                min: 1e-12,
+                up: 4.0,
+                singular: 10.0,
+            },
+        ),
+        tries: Tries::WhileBelow(1e12),
+        progress: |old, new| (old - new) / old.max(1e-300) > 1e-10,
+    };
+    let m = least_squares::minimize(&mut problem, start, &schedule);
+    (m.state, m.cost, m.iterations)
 }
 
 /// Moves a camera by `(ω, δt, δf)`: rotation `exp(ω) R`, translation `t + δt`, `f + δf`.

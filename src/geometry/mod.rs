@@ -1,16 +1,20 @@
 //! Geometry: triangle meshes with rest (pattern) coordinates, grid generators, edge/hinge
-//! adjacency, and mesh file I/O (OBJ read/write, binary glTF write).
+//! adjacency, mesh file I/O (OBJ read/write, binary glTF write), the pinhole camera
+//! ([`camera`]), and the Levenberg–Marquardt solver ([`least_squares`]).
 
+pub mod camera;
 pub mod cone;
 pub mod error;
 pub mod files;
 pub mod gltf;
 pub mod grid;
+pub mod least_squares;
 pub mod mesh;
 pub mod obj;
 pub mod random;
 pub mod topology;
 
+pub use camera::{Camera, LookAtCamera};
 pub use error::GeometryError;
 pub use files::photo_files;
 pub use gltf::write_glb;

@@ -1,14 +1,20 @@
-//! Built-in software rendering, so a user sees a result without another tool: a pinhole
-//! [`Camera`] (with automatic framing of a bounding box) and a z-buffered, smooth-shaded
-//! triangle rasterizer that draws [`RenderMesh`]es into an RGB image or a PNG file.
+//! Built-in software rendering, so a user sees a result without another tool, and the
+//! rasterizer of the vision code:
+//!
+//! - [`picture`]: smooth-shaded, supersampled pictures of [`RenderMesh`]es seen by a
+//!   [`LookAtCamera`](crate::geometry::LookAtCamera), as an RGB image or a PNG file;
+//! - [`raster`]: the z-buffered vertex-colour rasterizer (depth and interpolated colours or
+//!   texture coordinates) that the body tracker, its synthetic sequences and the face code
+//!   draw through a calibrated [`Camera`](crate::geometry::Camera);
+//! - [`plot`]: line plots.
 
-pub mod camera;
+pub mod picture;
 pub mod plot;
 pub mod raster;
 mod shading;
 
-pub use camera::Camera;
+pub use picture::{render, render_png, RenderMesh};
 pub use plot::{
     write_plot, write_plot_pair, write_series_csv, PlotError, PlotSpec, Series, SeriesStyle,
 };
-pub use raster::{render, render_png, RenderMesh};
+pub use raster::{draw_triangles, project_vertices, RasterTarget};

@@ -1,262 +1,251 @@
-//! Software rasterizer: z-buffered, perspective-correct triangles with smooth double-sided
-//! Lambert shading over a light gradient background, 2 × 2 supersampled, deterministic; and
-//! PNG output of the result.
+//! The z-buffered vertex-colour rasterizer of the vision code: the body tracker and its
+//! synthetic sequences, and the face tracker, renderer, texture baker and previews.
+//!
+//! [`project_vertices`] maps world points through a [`Camera`] (distortion included) to pixel
+//! coordinates and camera depth; [`draw_triangles`] fills triangles into a [`RasterTarget`]
+//! (depth buffer plus colour buffer), nearest depth winning, colours interpolated linearly in
+//! the image (Gouraud), depth interpolated as `1/z` (exact for planar triangles).
+//!
+//! Conventions: pixel `(x, y)` is sampled at its centre. In the coordinates of
+//! [`project_vertices`] (the [`Camera`]'s: pixel `(0, 0)` is the centre of the top-left pixel)
+//! that centre is the point `(x, y)`; counting pixel squares as `[x, x+1) × [y, y+1)` it is
+//! `(x + 0.5, y + 0.5)`. A triangle covers a pixel when it contains the pixel's centre.
+//! Vertices are snapped to 1/256 pixel and edge functions are evaluated in exact integer
+//! arithmetic with the top-left fill rule, so two triangles sharing an edge never draw a pixel
+//! twice and leave no gap. Both windings are drawn (no culling).
+//!
+//! The tracker calls [`draw_triangles`] thousands of times per frame: nothing here allocates
+//! once the buffers have their size, and [`RasterTarget::clear`] only resets the box touched
+//! since the previous clear.
 
-use std::io::Write;
-use std::path::Path;
+use crate::geometry::{Camera, Vec3};
 
-use image::{ImageEncoder, RgbImage};
+/// Depth (metres, camera frame) at or below which a projected vertex is invalid (behind the
+/// camera or too close to it); [`project_vertices`] writes `z = 0` for such points.
+pub const NEAR: f32 = 0.05;
 
-use super::camera::{Camera, Frame, MAX_SIZE, NEAR};
-use super::shading::{background, shade, srgb_to_linear};
-use crate::geometry::files::write_atomic;
-use crate::geometry::mesh::vertex_normals;
-use crate::geometry::{GeometryError, Vec3};
+/// Sub-pixel precision of the snapped vertex coordinates (1/256 pixel).
+const SUBPIXEL: f64 = 256.0;
 
-/// A mesh to draw: borrowed positions and triangles, and a base colour (sRGB).
-#[derive(Debug, Clone, Copy)]
-pub struct RenderMesh<'a> {
-    /// Vertex positions (m).
-    pub positions: &'a [Vec3],
-    /// Triangles as vertex index triples (either winding; both sides are drawn).
-    pub triangles: &'a [[usize; 3]],
-    /// Base colour, 8-bit sRGB.
-    pub color: [u8; 3],
+/// Largest projected coordinate magnitude (pixels) drawn; triangles reaching further are
+/// skipped (they can only come from points nearly in the camera plane).
+const MAX_COORD: f32 = 1.0e6;
+
+/// A depth buffer and a colour buffer of one image, with the box touched since the last
+/// [`clear`](RasterTarget::clear).
+#[derive(Clone, Debug)]
+pub struct RasterTarget {
+    /// Image width, pixels.
+    pub width: usize,
+    /// Image height, pixels.
+    pub height: usize,
+    /// Camera depth of the nearest surface per pixel, row-major; `+∞` where nothing was drawn.
+    pub depth: Vec<f32>,
+    /// Colour of the nearest surface per pixel, row-major, linear 0..255; `[0, 0, 0]` where
+    /// nothing was drawn.
+    pub rgb: Vec<[f32; 3]>,
+    /// Touched box `x0, y0, x1, y1` (exclusive ends); empty when `x0 >= x1`.
+    touched: (usize, usize, usize, usize),
 }
 
-impl RenderMesh<'_> {
-    /// The default fabric colour: a muted denim blue.
-    pub const DEFAULT_COLOR: [u8; 3] = [72, 104, 150];
-}
-
-impl Default for RenderMesh<'_> {
-    /// An empty mesh of [`RenderMesh::DEFAULT_COLOR`].
-    fn default() -> Self {
-        RenderMesh {
-            positions: &[],
-            triangles: &[],
-            color: Self::DEFAULT_COLOR,
+impl RasterTarget {
+    /// An empty target of `width × height` pixels.
+    pub fn new(width: usize, height: usize) -> Self {
+        RasterTarget {
+            width,
+            height,
+            depth: vec![f32::INFINITY; width * height],
+            rgb: vec![[0.0; 3]; width * height],
+            touched: (0, 0, 0, 0),
         }
     }
-}
 
-/// Supersampling factor per axis for images up to this many pixels (1 above).
-const SUPERSAMPLE: usize = 2;
-const SUPERSAMPLE_MAX_PIXELS: u64 = 4_000_000;
-
-/// Renders `meshes` as seen by `camera` into an image of the camera's size (clamped to
-/// 1..=[`MAX_SIZE`]): z-buffered, perspective-correct, with per-vertex (smooth) normals turned
-/// toward the viewer, lit by a key and a fill light attached to the camera plus ambient light,
-/// over a vertical light-grey gradient. Triangles with an out-of-range index or a non-finite
-/// vertex are skipped; triangles are clipped at the near plane ([`NEAR`] in front of the eye).
-/// An unusable camera (see [`render_png`]) gives the background alone. Deterministic: the
-/// same input gives the same pixels.
-pub fn render(meshes: &[RenderMesh], camera: &Camera) -> RgbImage {
-    let (w, h) = camera.size();
-    let (w, h) = (w as usize, h as usize);
-    let s = if (w * h) as u64 <= SUPERSAMPLE_MAX_PIXELS {
-        SUPERSAMPLE
-    } else {
-        1
-    };
-    let mut target = Target {
-        w: w * s,
-        h: h * s,
-        depth: vec![f64::INFINITY; w * h * s * s],
-        color: Vec::new(),
-    };
-    target.color = (0..target.h)
-        .flat_map(|y| std::iter::repeat_n(background(y / s, h), target.w))
-        .collect();
-    if let Some(mut frame) = camera.frame() {
-        frame.focal *= s as f64;
-        frame.cx *= s as f64;
-        frame.cy *= s as f64;
-        for mesh in meshes {
-            draw_mesh(&mut target, &frame, mesh);
-        }
-    }
-    let mut img = RgbImage::new(w as u32, h as u32);
-    let n = (s * s) as u32;
-    for (i, px) in img.chunks_exact_mut(3).enumerate() {
-        let (x, y) = (i % w, i / w);
-        let mut sum = [0u32; 3];
-        for sy in 0..s {
-            for sx in 0..s {
-                let c = target.color[(y * s + sy) * target.w + x * s + sx];
-                (0..3).for_each(|k| sum[k] += u32::from(c[k]));
+    /// Resets depth to `+∞` and colour to black inside the box touched since the last clear
+    /// (everything outside it is already clear).
+    pub fn clear(&mut self) {
+        let (x0, y0, x1, y1) = self.touched;
+        if x0 < x1 && y0 < y1 {
+            for y in y0..y1 {
+                let row = y * self.width;
+                self.depth[row + x0..row + x1].fill(f32::INFINITY);
+                self.rgb[row + x0..row + x1].fill([0.0; 3]);
             }
         }
-        (0..3).for_each(|k| px[k] = ((sum[k] + n / 2) / n) as u8);
+        self.touched = (0, 0, 0, 0);
     }
-    img
-}
 
-/// Renders `meshes` (see [`render`]) and writes the picture as PNG to `path`, creating parent
-/// folders; written to a temporary file then renamed. Fails, naming the file, when the
-/// camera's width or height is outside 1..=[`MAX_SIZE`], the camera is unusable (non-finite
-/// values, eye on the target, field of view outside (0°, 180°)), or on an I/O error.
-pub fn render_png(
-    path: &Path,
-    meshes: &[RenderMesh],
-    camera: &Camera,
-) -> Result<(), GeometryError> {
-    let invalid = |m: String| GeometryError::Invalid(format!("{}: {m}", path.display()));
-    let sizes = 1..=MAX_SIZE;
-    if !sizes.contains(&camera.width) || !sizes.contains(&camera.height) {
-        return Err(invalid(format!(
-            "image size {} × {} must be within 1..={MAX_SIZE} pixels each way",
-            camera.width, camera.height
-        )));
+    /// The box `(x0, y0, x1, y1)` (exclusive ends) that drawing may have changed since the last
+    /// clear; `None` when nothing was drawn.
+    pub fn touched(&self) -> Option<(usize, usize, usize, usize)> {
+        let (x0, y0, x1, y1) = self.touched;
+        (x0 < x1 && y0 < y1).then_some(self.touched)
     }
-    if camera.frame().is_none() {
-        return Err(invalid(format!(
-            "unusable camera (eye {:?}, target {:?}, fov {}°): eye must differ from target, values be finite, fov within (0, 180)",
-            camera.eye.as_slice(),
-            camera.target.as_slice(),
-            camera.fov_y_deg
-        )));
+
+    /// Whether something was drawn at pixel `(x, y)` (false outside the image).
+    pub fn covered(&self, x: usize, y: usize) -> bool {
+        x < self.width && y < self.height && self.depth[y * self.width + x].is_finite()
     }
-    let img = render(meshes, camera);
-    let mut png = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut png)
-        .write_image(
-            img.as_raw(),
-            img.width(),
-            img.height(),
-            image::ExtendedColorType::Rgb8,
-        )
-        .map_err(|e| invalid(format!("PNG encoding failed: {e}")))?;
-    write_atomic(path, |w: &mut dyn Write| w.write_all(&png))
-}
 
-/// Sample buffers: colour (sRGB) and depth along the view axis.
-struct Target {
-    w: usize,
-    h: usize,
-    depth: Vec<f64>,
-    color: Vec<[u8; 3]>,
-}
-
-/// A vertex in camera coordinates (x right, y up, z forward) with its normal.
-#[derive(Debug, Clone, Copy)]
-struct CamVertex {
-    p: Vec3,
-    n: Vec3,
-}
-
-/// Draws the valid triangles of one mesh.
-fn draw_mesh(target: &mut Target, frame: &Frame, mesh: &RenderMesh) {
-    let pos = mesh.positions;
-    let n = pos.len();
-    let ok = |i: usize| i < n && pos[i].iter().all(|c| c.is_finite());
-    let valid: Vec<[usize; 3]> = mesh
-        .triangles
-        .iter()
-        .filter(|t| t.iter().all(|&i| ok(i)))
-        .copied()
-        .collect();
-    let normals = vertex_normals(pos, &valid);
-    let base = mesh.color.map(srgb_to_linear);
-    for tri in &valid {
-        let v = tri.map(|i| CamVertex {
-            p: frame.camera_coords(&pos[i]),
-            n: frame.camera_dir(&normals[i]),
-        });
-        let face_n = (v[1].p - v[0].p).cross(&(v[2].p - v[0].p));
-        let (poly, len) = clip_near(&v);
-        for k in 1..len.saturating_sub(1) {
-            raster(
-                target,
-                frame,
-                [poly[0], poly[k], poly[k + 1]],
-                &face_n,
-                &base,
-            );
+    fn touch(&mut self, x0: usize, y0: usize, x1: usize, y1: usize) {
+        let t = &mut self.touched;
+        if t.0 >= t.2 {
+            *t = (x0, y0, x1, y1);
+        } else {
+            *t = (t.0.min(x0), t.1.min(y0), t.2.max(x1), t.3.max(y1));
         }
     }
 }
 
-/// Clips a triangle to the half-space z ≥ [`NEAR`]: a polygon of 0, 3 or 4 vertices.
-fn clip_near(v: &[CamVertex; 3]) -> ([CamVertex; 4], usize) {
-    let mut out = [v[0]; 4];
-    let mut len = 0;
-    for i in 0..3 {
-        let (a, b) = (v[i], v[(i + 1) % 3]);
-        let (ina, inb) = (a.p.z >= NEAR, b.p.z >= NEAR);
-        if ina {
-            out[len] = a;
-            len += 1;
+/// Projects world points through `camera` into `out` (resized, reused): pixel `x`, `y` and
+/// camera depth `z` (metres). Points with `z <= NEAR`, or outside the region where the radial
+/// distortion is monotonic (where it would fold the image back), get `[0, 0, 0]`: invalid,
+/// so the triangles using them are skipped.
+pub fn project_vertices(camera: &Camera, positions: &[Vec3], out: &mut Vec<[f32; 3]>) {
+    out.clear();
+    out.extend(positions.iter().map(|p| {
+        let pc = camera.to_camera_frame(p);
+        if pc.z.is_nan() || pc.z <= NEAR as f64 {
+            return [0.0; 3];
         }
-        if ina != inb {
-            let t = (NEAR - a.p.z) / (b.p.z - a.p.z);
-            out[len] = CamVertex {
-                p: a.p.lerp(&b.p, t),
-                n: a.n.lerp(&b.n, t),
-            };
-            out[len].p.z = NEAR;
-            len += 1;
+        let (x, y) = (pc.x / pc.z, pc.y / pc.z);
+        let r2 = x * x + y * y;
+        if 1.0 + 3.0 * camera.k1 * r2 + 5.0 * camera.k2 * r2 * r2 <= 0.0 {
+            return [0.0; 3];
         }
+        let uv = camera.project_camera_frame_unchecked(&pc);
+        if uv[0].is_finite() && uv[1].is_finite() {
+            [uv[0] as f32, uv[1] as f32, pc.z as f32]
+        } else {
+            [0.0; 3]
+        }
+    }));
+}
+
+/// Whether a projected vertex can be drawn.
+#[inline]
+fn valid(p: &[f32; 3]) -> bool {
+    p[2] > NEAR && p[0].abs() < MAX_COORD && p[1].abs() < MAX_COORD
+}
+
+/// Draws `triangles` (indices into `projected` and `colours`, which must have the same
+/// length; out-of-range indices skip the triangle) into `target`: both windings, Gouraud
+/// colours, nearest depth wins, top-left fill rule, clipped to the image. Triangles with an
+/// invalid vertex (see [`project_vertices`]) or no area are skipped.
+pub fn draw_triangles(
+    target: &mut RasterTarget,
+    projected: &[[f32; 3]],
+    colours: &[[f32; 3]],
+    triangles: &[[u32; 3]],
+) {
+    let n = projected.len().min(colours.len());
+    for t in triangles {
+        let (i0, i1, i2) = (t[0] as usize, t[1] as usize, t[2] as usize);
+        if i0 >= n || i1 >= n || i2 >= n {
+            continue;
+        }
+        draw_one(
+            target,
+            [&projected[i0], &projected[i1], &projected[i2]],
+            [&colours[i0], &colours[i1], &colours[i2]],
+        );
     }
-    (out, len)
 }
 
-/// Signed doubled area of (a, b, p): positive when p is left of a→b in pixel coordinates.
-fn edge(a: (f64, f64), b: (f64, f64), p: (f64, f64)) -> f64 {
-    (b.0 - a.0) * (p.1 - a.1) - (b.1 - a.1) * (p.0 - a.0)
-}
-
-/// Rasterizes one triangle in front of the near plane into the sample buffers.
-fn raster(t: &mut Target, frame: &Frame, v: [CamVertex; 3], face_n: &Vec3, base: &[f64; 3]) {
-    let s = v.map(|v| frame.pixel(&v.p));
-    let area = edge(s[0], s[1], s[2]);
-    if area.is_nan() || area.abs() <= 1e-12 {
+/// Draws one triangle (see [`draw_triangles`]).
+#[inline]
+fn draw_one(target: &mut RasterTarget, p: [&[f32; 3]; 3], c: [&[f32; 3]; 3]) {
+    if !(valid(p[0]) && valid(p[1]) && valid(p[2])) {
         return;
     }
+    let snap = |v: f32| (v as f64 * SUBPIXEL).round() as i64;
+    let mut v = [
+        (snap(p[0][0]), snap(p[0][1])),
+        (snap(p[1][0]), snap(p[1][1])),
+        (snap(p[2][0]), snap(p[2][1])),
+    ];
+    let mut order = [0usize, 1, 2];
+    let edge = |a: (i64, i64), b: (i64, i64), q: (i64, i64)| {
+        (b.0 - a.0) * (q.1 - a.1) - (b.1 - a.1) * (q.0 - a.0)
+    };
+    let mut area = edge(v[0], v[1], v[2]);
+    if area == 0 {
+        return;
+    }
+    if area < 0 {
+        v.swap(1, 2);
+        order.swap(1, 2);
+        area = -area;
+    }
+    // pixel range whose centres (integer projected coordinates) may be inside
+    let s = SUBPIXEL as i64;
     let (min_x, max_x) = (
-        s[0].0.min(s[1].0).min(s[2].0),
-        s[0].0.max(s[1].0).max(s[2].0),
+        v[0].0.min(v[1].0).min(v[2].0),
+        v[0].0.max(v[1].0).max(v[2].0),
     );
     let (min_y, max_y) = (
-        s[0].1.min(s[1].1).min(s[2].1),
-        s[0].1.max(s[1].1).max(s[2].1),
+        v[0].1.min(v[1].1).min(v[2].1),
+        v[0].1.max(v[1].1).max(v[2].1),
     );
-    // Samples at (i + 0.5, j + 0.5) inside the bounding box, within the image.
-    let range = |lo: f64, hi: f64, n: usize| {
-        let a = (lo - 0.5).ceil().max(0.0);
-        let b = (hi - 0.5).floor().min(n as f64 - 1.0);
-        (a as usize, b as isize)
-    };
-    let (x0, x1) = range(min_x, max_x, t.w);
-    let (y0, y1) = range(min_y, max_y, t.h);
-    if x1 < x0 as isize || y1 < y0 as isize {
+    let x0 = (min_x + s - 1).div_euclid(s).max(0);
+    let y0 = (min_y + s - 1).div_euclid(s).max(0);
+    let x1 = (max_x.div_euclid(s) + 1).min(target.width as i64);
+    let y1 = (max_y.div_euclid(s) + 1).min(target.height as i64);
+    if x0 >= x1 || y0 >= y1 {
         return;
     }
-    let inv_z = v.map(|v| 1.0 / v.p.z);
-    const EPS: f64 = -1e-9;
-    for y in y0..=y1 as usize {
-        let py = y as f64 + 0.5;
-        for x in x0..=x1 as usize {
-            let p = (x as f64 + 0.5, py);
-            let b = [
-                edge(s[1], s[2], p) / area,
-                edge(s[2], s[0], p) / area,
-                edge(s[0], s[1], p) / area,
-            ];
-            if b[0] < EPS || b[1] < EPS || b[2] < EPS {
-                continue;
+    target.touch(x0 as usize, y0 as usize, x1 as usize, y1 as usize);
+
+    // edge k is opposite vertex k: w_k(q) = edge(v[k+1], v[k+2], q); a pixel on an edge is
+    // inside only for top-left edges (bias −1 on the others, the test being w >= 0)
+    let e = [(1usize, 2usize), (2, 0), (0, 1)];
+    let mut w_row = [0i64; 3];
+    let mut step_x = [0i64; 3];
+    let mut step_y = [0i64; 3];
+    let mut bias = [0f32; 3];
+    let start = (x0 * s, y0 * s);
+    for k in 0..3 {
+        let (a, b) = (v[e[k].0], v[e[k].1]);
+        let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+        let top_left = dy < 0 || (dy == 0 && dx > 0);
+        w_row[k] = edge(a, b, start) - i64::from(!top_left);
+        bias[k] = f32::from(u8::from(!top_left));
+        step_x[k] = -dy * s;
+        step_y[k] = dx * s;
+    }
+    let inv_area = 1.0 / area as f32;
+    let pz = [p[order[0]][2], p[order[1]][2], p[order[2]][2]];
+    let iz = [1.0 / pz[0], 1.0 / pz[1], 1.0 / pz[2]];
+    let col = [c[order[0]], c[order[1]], c[order[2]]];
+    let width = target.width;
+    for y in y0..y1 {
+        let mut w = w_row;
+        let row = y as usize * width;
+        for x in x0..x1 {
+            if (w[0] | w[1] | w[2]) >= 0 {
+                // barycentric weights (the fill-rule biases added back)
+                let l = [
+                    (w[0] as f32 + bias[0]) * inv_area,
+                    (w[1] as f32 + bias[1]) * inv_area,
+                    (w[2] as f32 + bias[2]) * inv_area,
+                ];
+                let inv_z = l[0] * iz[0] + l[1] * iz[1] + l[2] * iz[2];
+                let z = 1.0 / inv_z;
+                let i = row + x as usize;
+                if z < target.depth[i] {
+                    target.depth[i] = z;
+                    target.rgb[i] = [
+                        l[0] * col[0][0] + l[1] * col[1][0] + l[2] * col[2][0],
+                        l[0] * col[0][1] + l[1] * col[1][1] + l[2] * col[2][1],
+                        l[0] * col[0][2] + l[1] * col[1][2] + l[2] * col[2][2],
+                    ];
+                }
             }
-            let q = [b[0] * inv_z[0], b[1] * inv_z[1], b[2] * inv_z[2]];
-            let qs = q[0] + q[1] + q[2];
-            let z = 1.0 / qs;
-            let idx = y * t.w + x;
-            if z.is_nan() || z >= t.depth[idx] {
-                continue;
+            for k in 0..3 {
+                w[k] += step_x[k];
             }
-            t.depth[idx] = z;
-            let normal = (v[0].n * q[0] + v[1].n * q[1] + v[2].n * q[2]) * z;
-            let point = (v[0].p * q[0] + v[1].p * q[1] + v[2].p * q[2]) * z;
-            t.color[idx] = shade(base, &normal, face_n, &point);
+        }
+        for k in 0..3 {
+            w_row[k] += step_y[k];
         }
     }
 }
@@ -264,169 +253,127 @@ fn raster(t: &mut Target, frame: &Frame, v: [CamVertex; 3], face_n: &Vec3, base:
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::{grid_mesh, mesh::bounds};
 
-    fn mesh<'a>(g: &'a crate::geometry::TriMesh) -> RenderMesh<'a> {
-        RenderMesh {
-            positions: &g.positions,
-            triangles: &g.triangles,
-            ..Default::default()
-        }
-    }
-
-    fn corners(w: u32, h: u32) -> [(u32, u32); 4] {
-        [(0, 0), (w - 1, 0), (0, h - 1), (w - 1, h - 1)]
+    fn count(t: &RasterTarget) -> usize {
+        t.depth.iter().filter(|d| d.is_finite()).count()
     }
 
     #[test]
-    fn grid_from_above_covers_the_centre_not_the_corners() {
-        let g = grid_mesh(1.0, 0.5, 4, 3).unwrap();
-        let cam = Camera {
-            eye: Vec3::new(0.0, 0.0, 1.5),
-            up: Vec3::y(),
-            ..Camera::default()
-        };
-        let img = render(&[mesh(&g)], &cam);
-        let bg = render(&[], &cam);
-        assert_eq!((img.width(), img.height()), (800, 600));
-        assert_ne!(img.get_pixel(400, 300), bg.get_pixel(400, 300));
-        for (x, y) in corners(800, 600) {
-            assert_eq!(img.get_pixel(x, y), bg.get_pixel(x, y));
-        }
-        // Covered area matches the projected size: 1 m spans 300 / tan 20° / 1.5 pixels.
-        let m = 300.0 / 20f64.to_radians().tan() / 1.5;
-        let expected = (1.0 * m) * (0.5 * m);
-        let covered = img
-            .pixels()
-            .zip(bg.pixels())
-            .filter(|(a, b)| a != b)
-            .count() as f64;
-        assert!(
-            (covered / expected - 1.0).abs() < 0.02,
-            "{covered} vs {expected}"
-        );
-    }
-
-    #[test]
-    fn framing_camera_sees_a_draped_looking_grid() {
-        let mut g = grid_mesh(1.0, 0.5, 20, 10).unwrap();
-        for p in &mut g.positions {
-            p.z = -0.3 * (p.x * 3.0).cos() * p.y;
-        }
-        let (lo, hi) = bounds(&g.positions);
-        let cam = Camera::framing(lo, hi, 320, 240);
-        let img = render(&[mesh(&g)], &cam);
-        let bg = render(&[], &cam);
-        let (x, y, _) = cam.project(Vec3::zeros()).unwrap();
-        let (x, y) = (x as u32, y as u32);
-        assert_ne!(img.get_pixel(x, y), bg.get_pixel(x, y));
-        for (x, y) in corners(320, 240) {
-            assert_eq!(img.get_pixel(x, y), bg.get_pixel(x, y));
-        }
-        assert_eq!(img, render(&[mesh(&g)], &cam), "not deterministic");
-    }
-
-    #[test]
-    fn behind_the_camera_draws_nothing_and_straddling_is_clipped() {
-        let cam = Camera::look_at(Vec3::zeros(), Vec3::x());
-        let bg = render(&[], &cam);
-        let behind = [
-            Vec3::new(-1.0, -1.0, -1.0),
-            Vec3::new(-1.0, 1.0, -1.0),
-            Vec3::new(-1.0, 0.0, 1.0),
-        ];
-        let tri = [[0, 1, 2]];
-        let m = RenderMesh {
-            positions: &behind,
-            triangles: &tri,
-            color: [200, 0, 0],
-        };
-        assert_eq!(render(&[m], &cam), bg);
-        // A triangle through the eye's plane shows its front part only, without panicking.
-        let straddle = [
-            Vec3::new(-1.0, -1.0, -0.2),
-            Vec3::new(2.0, 1.0, -0.2),
-            Vec3::new(2.0, -1.0, -0.2),
-        ];
-        let m = RenderMesh {
-            positions: &straddle,
-            triangles: &tri,
-            color: [200, 0, 0],
-        };
-        assert_ne!(render(&[m], &cam), bg);
-    }
-
-    #[test]
-    fn bad_input_is_skipped_and_depth_is_respected() {
+    fn square_of_two_triangles_covers_its_pixels_once() {
+        // square from (2.3, 1.7) to (12.3, 9.7) in projected coordinates: pixel centres with
+        // x in 3..=12 and y in 2..=9 → 10 × 8 pixels, whatever the diagonal or winding
         let p = [
-            Vec3::new(-1.0, -1.0, 0.0),
-            Vec3::new(1.0, -1.0, 0.0),
-            Vec3::new(0.0, 1.0, 0.0),
-            Vec3::new(f64::NAN, 0.0, 0.0),
+            [2.3, 1.7, 2.0],
+            [12.3, 1.7, 2.0],
+            [12.3, 9.7, 2.0],
+            [2.3, 9.7, 2.0],
         ];
-        let cam = Camera {
-            eye: Vec3::new(0.0, 0.0, 4.0),
-            up: Vec3::y(),
-            width: 64,
-            height: 48,
-            ..Camera::default()
-        };
-        let bg = render(&[], &cam);
-        let junk = [[0, 1, 3], [0, 1, 7]];
-        assert_eq!(
-            render(
-                &[RenderMesh {
-                    positions: &p,
-                    triangles: &junk,
-                    color: [9, 9, 9]
-                }],
-                &cam
-            ),
-            bg
-        );
-        // A red triangle above a blue one hides it, whatever the drawing order.
-        let up: Vec<Vec3> = p[..3].iter().map(|v| v + Vec3::z() * 0.5).collect();
-        let tri = [[0, 1, 2]];
-        let blue = RenderMesh {
-            positions: &p[..3],
-            triangles: &tri,
-            color: [0, 0, 255],
-        };
-        let red = RenderMesh {
-            positions: &up,
-            triangles: &tri,
-            color: [255, 0, 0],
-        };
-        for order in [[blue, red], [red, blue]] {
-            let c = render(&order, &cam).get_pixel(32, 26).0;
-            assert!(c[0] > 100 && c[2] < 60, "{c:?}");
+        let c = [[10.0, 20.0, 30.0]; 4];
+        for tris in [
+            [[0u32, 1, 2], [0, 2, 3]],
+            [[0, 2, 1], [3, 2, 0]],
+            [[0, 1, 3], [1, 2, 3]],
+        ] {
+            let mut t = RasterTarget::new(20, 15);
+            draw_triangles(&mut t, &p, &c, &tris);
+            assert_eq!(count(&t), 80);
+            assert_eq!(t.touched().map(|b| (b.0, b.1)), Some((3, 2)));
+            assert!(t.covered(3, 2) && t.covered(12, 9) && !t.covered(13, 9) && !t.covered(3, 10));
+            let rgb = t.rgb[5 * 20 + 5];
+            assert!(
+                (0..3).all(|i| (rgb[i] - [10.0, 20.0, 30.0][i]).abs() < 1e-3),
+                "{rgb:?}"
+            );
+            t.clear();
+            assert_eq!(count(&t), 0);
+            assert!(t.touched().is_none());
         }
-        // An unusable camera gives the background and render_png refuses it.
-        let still = Camera {
-            target: cam.eye,
-            ..cam.clone()
-        };
-        assert_eq!(render(&[red], &still), render(&[], &still));
-        let path = std::env::temp_dir().join("emilion-never-written.png");
-        assert!(render_png(&path, &[red], &still)
-            .unwrap_err()
-            .to_string()
-            .contains("never-written"));
-        let tiny = Camera { width: 0, ..cam };
-        assert!(render_png(&path, &[red], &tiny).is_err());
-        assert!(!path.exists());
+        // integer-aligned edges: a 4 × 4 square from (0.5, 0.5) drawn exactly once per pixel,
+        // and a mesh of 2 × 2 such squares as well (shared edges through pixel centres)
+        let mut t = RasterTarget::new(10, 10);
+        let q = [
+            [1.0, 1.0, 1.0],
+            [5.0, 1.0, 1.0],
+            [5.0, 5.0, 1.0],
+            [1.0, 5.0, 1.0],
+            [3.0, 3.0, 1.0],
+        ];
+        let fan = [[0u32, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]];
+        draw_triangles(&mut t, &q, &[[1.0; 3]; 5], &fan);
+        assert_eq!(count(&t), 16);
     }
 
     #[test]
-    fn png_round_trip() {
-        let g = grid_mesh(1.0, 0.5, 4, 3).unwrap();
-        let (lo, hi) = bounds(&g.positions);
-        let cam = Camera::framing(lo, hi, 120, 90);
-        let dir = std::env::temp_dir().join(format!("emilion-png-{}", std::process::id()));
-        let path = dir.join("a").join("grid.png");
-        render_png(&path, &[mesh(&g)], &cam).unwrap();
-        let back = image::open(&path).unwrap().to_rgb8();
-        assert_eq!(back, render(&[mesh(&g)], &cam));
-        std::fs::remove_dir_all(&dir).unwrap();
+    fn nearest_depth_wins_in_any_order_and_clipping_holds() {
+        let near = [[-5.0, -5.0, 2.0], [30.0, -5.0, 2.0], [-5.0, 30.0, 2.0]];
+        let far = [[-5.0, -5.0, 3.0], [30.0, -5.0, 3.0], [-5.0, 30.0, 3.0]];
+        let mut p = near.to_vec();
+        p.extend_from_slice(&far);
+        let mut c = vec![[200.0, 0.0, 0.0]; 3];
+        c.extend_from_slice(&[[0.0, 0.0, 200.0]; 3]);
+        for tris in [[[0u32, 1, 2], [3, 4, 5]], [[3, 4, 5], [0, 1, 2]]] {
+            let mut t = RasterTarget::new(8, 6);
+            draw_triangles(&mut t, &p, &c, &tris);
+            assert_eq!(count(&t), 48);
+            assert!(t.rgb.iter().all(|v| v[0] > 199.0 && v[2] < 1.0));
+            assert!(t.depth.iter().all(|&d| (d - 2.0).abs() < 1e-5));
+            assert_eq!(t.touched(), Some((0, 0, 8, 6)));
+        }
+        // a vertex behind the camera skips the triangle
+        let mut t = RasterTarget::new(8, 6);
+        let bad = [[0.0, 0.0, 2.0], [7.0, 0.0, 2.0], [0.0, 5.0, 0.0]];
+        draw_triangles(&mut t, &bad, &[[1.0; 3]; 3], &[[0, 1, 2], [0, 1, 7]]);
+        assert_eq!(count(&t), 0);
+    }
+
+    #[test]
+    fn jittered_mesh_has_no_holes_and_no_overdraw() {
+        // an 8 × 6 grid of quads over (2.3, 1.7)–(50.3, 37.7), inner vertices jittered, random
+        // diagonals and windings: covers the 48 × 36 pixel centres inside, each exactly once
+        let mut rng = crate::geometry::SplitMix64::new(5);
+        let (nx, ny) = (8usize, 6usize);
+        let mut p = Vec::new();
+        for j in 0..=ny {
+            for i in 0..=nx {
+                let inner = i > 0 && i < nx && j > 0 && j < ny;
+                let jit = |r: &mut crate::geometry::SplitMix64| {
+                    if inner {
+                        r.range(-2.0, 2.0)
+                    } else {
+                        0.0
+                    }
+                };
+                let x = 2.3 + 6.0 * i as f32 + jit(&mut rng) as f32;
+                let y = 1.7 + 6.0 * j as f32 + jit(&mut rng) as f32;
+                p.push([x, y, 1.0 + 0.01 * i as f32]);
+            }
+        }
+        let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
+        let mut tris = Vec::new();
+        for j in 0..ny {
+            for i in 0..nx {
+                let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+                let pair = if rng.bit() {
+                    [[a, b, c], [a, c, d]]
+                } else {
+                    [[a, b, d], [b, c, d]]
+                };
+                for t in pair {
+                    tris.push(if rng.bit() { t } else { [t[0], t[2], t[1]] });
+                }
+            }
+        }
+        let colours = vec![[1.0; 3]; p.len()];
+        let mut all = RasterTarget::new(60, 45);
+        draw_triangles(&mut all, &p, &colours, &tris);
+        assert_eq!(count(&all), 48 * 36);
+        let mut one = RasterTarget::new(60, 45);
+        let mut sum = 0;
+        for t in &tris {
+            one.clear();
+            draw_triangles(&mut one, &p, &colours, std::slice::from_ref(t));
+            sum += count(&one);
+        }
+        assert_eq!(sum, 48 * 36, "pixels drawn by more than one triangle");
     }
 }

@@ -9,8 +9,9 @@ use super::convert::{arr3, count, finite, rt_err, to_map, RResult};
 use super::{register, SimHandle};
 use crate::cloth::{stats, Simulation};
 use crate::contact::tessellate::body_mesh;
+use crate::geometry::LookAtCamera;
 use crate::geometry::{mesh::bounds, write_glb, write_obj};
-use crate::render::{render_png, Camera, RenderMesh};
+use crate::render::{render_png, RenderMesh};
 
 /// Creates the parent folder of an output file.
 fn parent_dir(path: &str) -> RResult<()> {
@@ -24,13 +25,13 @@ fn parent_dir(path: &str) -> RResult<()> {
 }
 
 /// A camera that frames the simulation's current bounds.
-fn auto_camera(sim: &Simulation, width: u32, height: u32) -> Camera {
+fn auto_camera(sim: &Simulation, width: u32, height: u32) -> LookAtCamera {
     let (lo, hi) = bounds(&sim.state.x);
-    Camera::framing(lo, hi, width, height)
+    LookAtCamera::framing(lo, hi, width, height)
 }
 
 /// A camera from `#{eye, target, up, fov, width, height}`; eye and target default to framing.
-fn camera(sim: &Simulation, m: &Map) -> RResult<Camera> {
+fn camera(sim: &Simulation, m: &Map) -> RResult<LookAtCamera> {
     const KEYS: [&str; 6] = ["eye", "target", "up", "fov", "width", "height"];
     if let Some(k) = m.keys().find(|k| !KEYS.contains(&k.as_str())) {
         return Err(rt_err(format!(
@@ -67,7 +68,7 @@ fn camera(sim: &Simulation, m: &Map) -> RResult<Camera> {
 const BODY_COLOR: [u8; 3] = [206, 196, 178];
 
 /// Renders the cloth's current shape and the collision bodies to a PNG file.
-fn render(sim: &Simulation, path: &str, cam: &Camera) -> RResult<()> {
+fn render(sim: &Simulation, path: &str, cam: &LookAtCamera) -> RResult<()> {
     parent_dir(path)?;
     let (lo, hi) = bounds(&sim.state.x);
     let bodies: Vec<_> = sim

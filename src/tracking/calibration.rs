@@ -6,7 +6,7 @@
 //!    non-coplanar points, ignoring distortion;
 //! 2. [`decompose_projection`]: an RQ decomposition `P = λ K [R | t]` with positive focal lengths
 //!    and `det R = +1` (the skew of `K` is dropped, the camera model has none);
-//! 3. a hand-written Levenberg–Marquardt refinement of `fx, fy, cx, cy, k1, k2`, the rotation
+//! 3. a Levenberg–Marquardt refinement (the damping of [`crate::geometry::least_squares`]) of `fx, fy, cx, cy, k1, k2`, the rotation
 //!    (as an axis-angle increment composed on the left of the current rotation) and the
 //!    translation, minimising the squared pixel reprojection error with a central-difference
 //!    Jacobian and Nielsen's damping update.
@@ -15,62 +15,15 @@
 
 use nalgebra::{DMatrix, Matrix3, Rotation3, SMatrix, SVector, Vector3};
 
-use super::camera::Camera;
+pub use super::correspondences::{CalibrationError, MIN_POINTS};
 pub use super::dlt::{decompose_projection, dlt, KRt};
+use crate::geometry::least_squares::{Damping, DampingUpdate, DiagonalDamping};
+use crate::geometry::Camera;
 
 /// Number of refined parameters: fx, fy, cx, cy, k1, k2, ω (3), t (3).
 const NPARAM: usize = 12;
 type Params = SVector<f64, NPARAM>;
 type Normal = SMatrix<f64, NPARAM, NPARAM>;
-
-/// Fewest correspondences accepted (the DLT needs 5½).
-pub const MIN_POINTS: usize = 6;
-
-/// Why a calibration could not be computed.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum CalibrationError {
-    /// Fewer than [`MIN_POINTS`] correspondences.
-    #[error("too few points for calibration: got {got}, need at least {needed}")]
-    TooFewPoints {
-        /// Number of correspondences given.
-        got: usize,
-        /// Minimum required.
-        needed: usize,
-    },
-    /// The 3D and 2D lists differ in length.
-    #[error("mismatched inputs: {points} 3D points but {pixels} pixel observations")]
-    LengthMismatch {
-        /// Number of 3D points.
-        points: usize,
-        /// Number of 2D observations.
-        pixels: usize,
-    },
-    /// A coordinate is NaN or infinite.
-    #[error("non-finite input: {what} {index} has a NaN or infinite coordinate")]
-    NonFinite {
-        /// `"3D point"` or `"pixel"`.
-        what: &'static str,
-        /// Index of the offending correspondence.
-        index: usize,
-    },
-    /// The 3D points lie on a plane, a line or a point: the DLT is then undetermined.
-    #[error(
-        "degenerate 3D points: they are {shape} (spread ratios {ratio_2:.2e}, {ratio_3:.2e}); \
-         the DLT needs non-coplanar points"
-    )]
-    DegeneratePoints {
-        /// `"coplanar"`, `"collinear"` or `"coincident"`.
-        shape: &'static str,
-        /// √(λ₂/λ₁) of the point covariance.
-        ratio_2: f64,
-        /// √(λ₃/λ₁) of the point covariance.
-        ratio_3: f64,
-    },
-    /// The linear or decomposition stage found no valid camera (e.g. coincident pixels,
-    /// points on both sides of the camera, or a reflection).
-    #[error("degenerate configuration: {0}")]
-    Degenerate(String),
-}
 
 /// Options of [`calibrate_with`].
 #[derive(Debug, Clone, PartialEq)]
@@ -107,80 +60,6 @@ pub struct Calibration {
     pub iterations: usize,
     /// Whether a stopping test (small step or gradient) was met before `max_iterations`.
     pub converged: bool,
-}
-
-/// Checks lengths, counts and finiteness of the correspondences.
-pub(crate) fn check_inputs(
-    points: &[Vector3<f64>],
-    pixels: &[[f64; 2]],
-) -> Result<(), CalibrationError> {
-    if points.len() != pixels.len() {
-        return Err(CalibrationError::LengthMismatch {
-            points: points.len(),
-            pixels: pixels.len(),
-        });
-    }
-    if points.len() < MIN_POINTS {
-        return Err(CalibrationError::TooFewPoints {
-            got: points.len(),
-            needed: MIN_POINTS,
-        });
-    }
-    if let Some(index) = points.iter().position(|p| !p.iter().all(|v| v.is_finite())) {
-        return Err(CalibrationError::NonFinite {
-            what: "3D point",
-            index,
-        });
-    }
-    if let Some(index) = pixels
-        .iter()
-        .position(|p| !(p[0].is_finite() && p[1].is_finite()))
-    {
-        return Err(CalibrationError::NonFinite {
-            what: "pixel",
-            index,
-        });
-    }
-    Ok(())
-}
-
-/// Rejects coplanar, collinear and coincident 3D point sets (relative spread below 1e-6).
-pub(crate) fn check_spread(points: &[Vector3<f64>]) -> Result<(), CalibrationError> {
-    let n = points.len() as f64;
-    let mean = points.iter().sum::<Vector3<f64>>() / n;
-    let mut cov = Matrix3::zeros();
-    for p in points {
-        let d = p - mean;
-        cov += d * d.transpose();
-    }
-    cov /= n;
-    let mut ev: Vec<f64> = cov
-        .symmetric_eigenvalues()
-        .iter()
-        .map(|v| v.max(0.0))
-        .collect();
-    ev.sort_by(|a, b| b.total_cmp(a));
-    let (l1, l2, l3) = (ev[0], ev[1], ev[2]);
-    let ratio_2 = if l1 > 0.0 { (l2 / l1).sqrt() } else { 0.0 };
-    let ratio_3 = if l1 > 0.0 { (l3 / l1).sqrt() } else { 0.0 };
-    const TOL: f64 = 1e-6;
-    let shape = if l1 <= 0.0 {
-        Some("coincident")
-    } else if ratio_2 < TOL {
-        Some("collinear")
-    } else if ratio_3 < TOL {
-        Some("coplanar")
-    } else {
-        None
-    };
-    match shape {
-        Some(shape) => Err(CalibrationError::DegeneratePoints {
-            shape,
-            ratio_2,
-            ratio_3,
-        }),
-        None => Ok(()),
-    }
 }
 
 /// Unpacks the refinement parameters onto a camera whose rotation is `base`.
@@ -293,8 +172,15 @@ pub fn calibrate_with(
         .filter(|&i| options.estimate_distortion || !(i == 4 || i == 5))
         .collect();
 
-    let mut mu = -1.0;
-    let mut nu = 2.0;
+    // Nielsen's damping; λ set from the first Jacobian
+    let mut damping = Damping::new(
+        -1.0,
+        DiagonalDamping::Clamped {
+            floor: 1e-12,
+            extra: 0.0,
+        },
+        DampingUpdate::Nielsen,
+    );
     let mut iterations = 0;
     let mut converged = false;
     let mut jac = DMatrix::<f64>::zeros(2 * n, NPARAM);
@@ -344,11 +230,11 @@ pub fn calibrate_with(
                 converged = true;
                 break;
             }
-            if mu < 0.0 {
-                mu = 1e-3 * active.iter().map(|&c| jtj[(c, c)]).fold(0.0, f64::max);
+            if damping.lambda < 0.0 {
+                damping.lambda = 1e-3 * active.iter().map(|&c| jtj[(c, c)]).fold(0.0, f64::max);
             }
         }
-        // damped normal equations on the active parameters (Marquardt scaling)
+        // damped normal equations on the active parameters (Marquardt scaling, floor 1e-12)
         let m = active.len();
         let mut a = DMatrix::<f64>::zeros(m, m);
         let mut b = nalgebra::DVector::<f64>::zeros(m);
@@ -356,16 +242,10 @@ pub fn calibrate_with(
             for (ib, &cb) in active.iter().enumerate() {
                 a[(ia, ib)] = jtj[(ca, cb)];
             }
-            a[(ia, ia)] += mu * jtj[(ca, ca)].max(1e-12);
-            b[ia] = -g[ca];
+            b[ia] = g[ca];
         }
-        let step = match a.cholesky() {
-            Some(ch) => ch.solve(&b),
-            None => {
-                mu *= nu;
-                nu *= 2.0;
-                continue;
-            }
+        let Some(step) = damping.solve(&a, &b) else {
+            continue;
         };
         let mut delta = Params::zeros();
         for (ia, &ca) in active.iter().enumerate() {
@@ -402,17 +282,15 @@ pub fn calibrate_with(
             let rel = (cost - cost_new) / cost.max(1e-300);
             res = res_new;
             cost = cost_new;
-            mu *= (1.0f64 / 3.0).max(1.0 - (2.0 * rho - 1.0).powi(3));
-            nu = 2.0;
+            damping.accept(rho);
             need_jacobian = true;
             if cost == 0.0 || rel < 1e-15 && delta.norm() <= 1e-9 * (xnorm + 1e-9) {
                 converged = true;
                 break;
             }
         } else {
-            mu *= nu;
-            nu *= 2.0;
-            if !mu.is_finite() {
+            damping.reject();
+            if !damping.lambda.is_finite() {
                 break;
             }
         }

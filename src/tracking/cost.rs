@@ -17,13 +17,13 @@
 
 use image::RgbImage;
 
-use super::camera::Camera;
 use super::puppet::Puppet;
 use super::puppet_mesh::TrackingMesh;
 use super::pyramid::{build_pyramid, lighting_gain, Level};
-use super::raster::{draw_triangles, project_vertices, RasterTarget};
 use crate::body::skinning::Pose;
+use crate::geometry::Camera;
 use crate::geometry::Vec3;
+use crate::render::raster::{draw_triangles, project_vertices, RasterTarget};
 
 /// Without colours, what covering a pixel costs before the background term: covering a
 /// background pixel (ρ(I − B) ≈ 0) costs this much, covering a foreground pixel

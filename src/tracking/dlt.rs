@@ -5,7 +5,7 @@
 
 use nalgebra::{DMatrix, Matrix3, Matrix3x4, Matrix4, Vector3};
 
-use super::calibration::{check_inputs, check_spread, CalibrationError};
+use super::correspondences::{check_inputs, check_spread, CalibrationError};
 
 /// `(K, R, t)` from [`decompose_projection`].
 pub type KRt = (Matrix3<f64>, Matrix3<f64>, Vector3<f64>);

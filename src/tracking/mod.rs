@@ -1,15 +1,14 @@
-//! Tracking: cameras, the tracking puppet and its joints, synthetic multi-camera sequences
-//! with ground truth, and the analysis-by-synthesis body tracker.
+//! Tracking: camera calibration, the tracking puppet and its joints, synthetic multi-camera
+//! sequences with ground truth, and the analysis-by-synthesis body tracker. The camera model
+//! is [`crate::geometry::Camera`]; images are drawn by [`crate::render::raster`].
 //!
-//! - [`camera`]: the pinhole camera with radial distortion used by every vision part, its
-//!   projection, and its JSON file format;
+//! - [`correspondences`]: checks of 3D–2D correspondences and the calibration error;
 //! - [`dlt`]: linear resection (normalised DLT) and the RQ split of a projection matrix;
 //! - [`calibration`]: camera calibration from 3D–2D correspondences (DLT, then
 //!   Levenberg–Marquardt refinement of intrinsics, distortion and pose);
 //! - [`joints`]: the sixteen tracking joints on the MakeHuman skeleton, and the error measure;
 //! - [`puppet`], [`puppet_mesh`]: the tracking puppet (pose parameters with joint limits,
 //!   forward kinematics onto the MakeHuman skeleton) and its light mesh for rendering;
-//! - [`raster`]: the z-buffered vertex-colour rasterizer shared by sequences and tracker;
 //! - [`clothing`], [`sequence`], [`sequence_files`]: synthetic multi-camera sequences with
 //!   ground truth, and reading any sequence folder;
 //! - [`pyramid`], [`texture`], [`cost`], [`annealing`], [`restarts`], [`tracker`]: the tracker;
@@ -18,8 +17,8 @@
 pub mod annealing;
 pub mod bvh_export;
 pub mod calibration;
-pub mod camera;
 pub mod clothing;
+pub mod correspondences;
 pub mod cost;
 pub mod dlt;
 pub mod joints;
@@ -27,7 +26,6 @@ pub mod overlay;
 pub mod puppet;
 pub mod puppet_mesh;
 pub mod pyramid;
-pub mod raster;
 pub mod restarts;
 pub mod sequence;
 pub mod sequence_files;

@@ -12,8 +12,8 @@ use std::path::Path;
 use image::RgbImage;
 
 use super::bvh_export::TrackingOutputError;
-use super::camera::Camera;
 use super::joints::{JOINT_COUNT, TRACKING_JOINTS};
+use crate::geometry::Camera;
 use crate::geometry::Vec3;
 
 /// Colours and sizes of a drawn skeleton.

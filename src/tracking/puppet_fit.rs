@@ -6,6 +6,9 @@ use nalgebra::{DMatrix, DVector, Matrix3, UnitQuaternion};
 
 use super::{Puppet, PARAM_COUNT};
 use crate::body::Pose;
+use crate::geometry::least_squares::{
+    self, DampingUpdate, DiagonalDamping, LeastSquares, Schedule, Tries,
+};
 use crate::geometry::Vec3;
 use crate::tracking::joints::JOINT_COUNT;
 
@@ -118,6 +121,12 @@ impl Puppet {
         }
     }
 
+    /// Projected Levenberg–Marquardt ([`least_squares::minimize`]) of the `active`
+    /// parameters of `p` on the residuals of [`residual`](Self::residual): forward
+    /// differences of ±1e-6 (backwards at an upper limit), steps clamped to the limits,
+    /// damping `μ (JᵀJ_kk + 1e-6)` from μ = 1e-3, divided by 3 (not below 1e-9) after an
+    /// accepted step, times 4 otherwise, 12 tries per iteration; stops when a step gains
+    /// less than 1e-14 of the cost.
     #[allow(clippy::too_many_arguments)]
     fn levenberg_marquardt(
         &self,
@@ -129,60 +138,88 @@ impl Puppet {
         pose: &mut Pose,
         iterations: usize,
     ) {
-        let m = 3 * joints.len() + active.iter().filter(|&&i| i >= 6).count();
-        let n = active.len();
-        let mut r = DVector::zeros(m);
-        let mut r2 = DVector::zeros(m);
-        let mut jac = DMatrix::zeros(m, n);
-        self.residual(p, active, joints, target, prior, pose, &mut r);
-        let mut cost = r.norm_squared();
-        let mut mu = 1e-3;
-        let mut q = p.to_vec();
-        for _ in 0..iterations {
-            for (c, &i) in active.iter().enumerate() {
-                q.copy_from_slice(p);
-                let h = if p[i] + 1e-6 > self.params[i].hi {
-                    -1e-6
-                } else {
-                    1e-6
-                };
-                q[i] += h;
-                self.residual(&q, active, joints, target, prior, pose, &mut r2);
-                jac.set_column(c, &((&r2 - &r) / h));
-            }
-            let jtj = jac.tr_mul(&jac);
-            let g = jac.tr_mul(&r);
-            let mut improved = false;
-            for _ in 0..12 {
-                let mut a = jtj.clone();
-                for d in 0..n {
-                    a[(d, d)] += mu * (jtj[(d, d)] + 1e-6);
-                }
-                let Some(ch) = a.cholesky() else {
-                    mu *= 4.0;
-                    continue;
-                };
-                let delta = ch.solve(&-&g);
-                q.copy_from_slice(p);
-                for (c, &i) in active.iter().enumerate() {
-                    q[i] += delta[c];
-                }
-                self.clamp(&mut q);
-                self.residual(&q, active, joints, target, prior, pose, &mut r2);
-                let c2 = r2.norm_squared();
-                if c2 < cost {
-                    improved = cost - c2 > 1e-14 * cost.max(1e-12);
-                    p.copy_from_slice(&q);
-                    std::mem::swap(&mut r, &mut r2);
-                    cost = c2;
-                    mu = (mu / 3.0).max(1e-9);
-                    break;
-                }
-                mu *= 4.0;
-            }
-            if !improved {
-                break;
-            }
+        let mut problem = JointFit {
+            puppet: self,
+            active,
+            joints,
+            target,
+            prior,
+            pose,
+            rows: 3 * joints.len() + active.iter().filter(|&&i| i >= 6).count(),
+        };
+        let schedule = Schedule {
+            iterations,
+            damping: (
+                1e-3,
+                DiagonalDamping::Shifted { floor: 1e-6 },
+                DampingUpdate::Factors {
+                    down: 3.0,
+                    min: 1e-9,
+                    up: 4.0,
+                    singular: 4.0,
+                },
+            ),
+            tries: Tries::Count(12),
+            // on the full squared norm 2·cost (exact doubling): a gain above 1e-14 of it
+            progress: |old, new| 2.0 * (old - new) > 1e-14 * (2.0 * old).max(1e-12),
+        };
+        let m = least_squares::minimize(&mut problem, p.to_vec(), &schedule);
+        p.copy_from_slice(&m.state);
+    }
+}
+
+/// The puppet's joint fit as a least-squares problem: the parameters `active` of the full
+/// parameter vector, the residuals of [`Puppet::residual`].
+struct JointFit<'a> {
+    puppet: &'a Puppet,
+    active: &'a [usize],
+    joints: &'a [usize],
+    target: &'a [Vec3; JOINT_COUNT],
+    prior: &'a [f64],
+    /// Scratch pose.
+    pose: &'a mut Pose,
+    /// Number of residuals.
+    rows: usize,
+}
+
+impl LeastSquares for JointFit<'_> {
+    type State = Vec<f64>;
+
+    fn parameter_count(&self) -> usize {
+        self.active.len()
+    }
+
+    fn residuals(&mut self, p: &Vec<f64>, out: &mut DVector<f64>) {
+        if out.len() != self.rows {
+            *out = DVector::zeros(self.rows);
         }
+        let (active, joints) = (self.active, self.joints);
+        self.puppet
+            .residual(p, active, joints, self.target, self.prior, self.pose, out);
+    }
+
+    fn jacobian(&mut self, p: &Vec<f64>, r: &DVector<f64>, jac: &mut DMatrix<f64>) {
+        let mut q = p.clone();
+        let mut r2 = DVector::zeros(self.rows);
+        for (c, &i) in self.active.iter().enumerate() {
+            q.copy_from_slice(p);
+            let h = if p[i] + 1e-6 > self.puppet.params[i].hi {
+                -1e-6
+            } else {
+                1e-6
+            };
+            q[i] += h;
+            self.residuals(&q, &mut r2);
+            jac.set_column(c, &((&r2 - r) / h));
+        }
+    }
+
+    fn step(&mut self, p: &Vec<f64>, delta: &DVector<f64>) -> Vec<f64> {
+        let mut q = p.clone();
+        for (c, &i) in self.active.iter().enumerate() {
+            q[i] += delta[c];
+        }
+        self.puppet.clamp(&mut q);
+        q
     }
 }

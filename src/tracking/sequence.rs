@@ -50,16 +50,16 @@ use indicatif::ProgressBar;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::camera::Camera;
 use super::clothing::{clothing_colours, dominant_bone, shaded_colours, skin_positions};
 use super::joints::{JointSet, TRACKING_JOINTS};
-use super::raster::{draw_triangles, project_vertices, RasterTarget};
 use super::sequence_files::{
     cover, image_path, io_err, list_photos, write_joints_csv, write_png, JointFrame, SequenceError,
 };
 use crate::body::{Animation, BodyError, Mannequin, Motion, RetargetOptions};
 use crate::geometry::files::data_dir;
+use crate::geometry::Camera;
 use crate::geometry::{SplitMix64, Vec3};
+use crate::render::raster::{draw_triangles, project_vertices, RasterTarget};
 
 /// Settings of [`make_sequence`]; see the [module docs](self) for what each does.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

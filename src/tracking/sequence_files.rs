@@ -28,9 +28,9 @@ use image::codecs::png::{CompressionType, FilterType, PngEncoder};
 use image::{ImageEncoder, RgbImage};
 use serde_json::Value;
 
-use super::camera::{Camera, CameraError};
 use super::joints::{joint_index, JOINT_COUNT, TRACKING_JOINTS};
 use crate::body::BodyError;
+use crate::geometry::camera::{Camera, CameraError};
 use crate::geometry::{SplitMix64, Vec3};
 
 /// Joint positions of one frame, in [`TRACKING_JOINTS`] order.

@@ -7,11 +7,11 @@
 //! static occluder stands in front of the person) give no colour: a limb behind an
 //! occluder in one camera takes its colour from the cameras that see it.
 
-use super::camera::Camera;
 use super::puppet_mesh::TrackingMesh;
 use super::pyramid::Level;
-use super::raster::{draw_triangles, project_vertices, RasterTarget};
+use crate::geometry::Camera;
 use crate::geometry::Vec3;
+use crate::render::raster::{draw_triangles, project_vertices, RasterTarget};
 
 /// Depth tolerance of the visibility test, metres.
 const VISIBILITY_TOLERANCE: f32 = 0.03;

@@ -214,7 +214,7 @@ impl Tracker {
     /// A tracker for `cameras` with their background models (full resolution).
     pub fn new(
         mannequin: &Mannequin,
-        cameras: &[super::camera::Camera],
+        cameras: &[crate::geometry::Camera],
         backgrounds: &[Level],
         options: TrackerOptions,
     ) -> Result<Tracker, TrackError> {

@@ -1,38 +1,14 @@
-//! Pinhole cameras with two-term radial distortion, and their JSON file format.
-//!
-//! # Model
-//!
-//! A world point `p` is moved into the camera frame by `pc = R p + t` ([`Camera::rotation`] is
-//! world→camera, [`Camera::translation`] is `t`); the camera looks down `+z`, `x` to the right
-//! and `y` down in the image. The ideal normalised coordinates `(x, y) = (pc.x / pc.z, pc.y / pc.z)`
-//! are distorted radially, `(x, y) · (1 + k1 r² + k2 r⁴)` with `r² = x² + y²`, then mapped to
-//! pixels by `u = fx · xd + cx`, `v = fy · yd + cy` (no skew). Pixel `(0, 0)` is the centre of
-//! the top-left pixel.
-//!
-//! # File format
-//!
-//! A camera file is one JSON object with two parts; every number is a finite JSON number:
-//!
-//! ```json
-//! {
-//!   "intrinsics": { "fx": 400.0, "fy": 400.0, "cx": 162.0, "cy": 118.0,
-//!                   "k1": -0.08, "k2": 0.02, "width": 320, "height": 240 },
-//!   "extrinsics": { "rotation": [[1, 0, 0], [0, 1, 0], [0, 0, 1]],
-//!                   "translation": [0.0, 0.0, 3.0] }
-//! }
-//! ```
-//!
-//! `fx, fy, cx, cy` are in pixels, `k1, k2` are dimensionless, `width, height` are positive
-//! integers (pixels). `rotation` is the world→camera matrix, row-major (three rows of three), and
-//! must be a proper rotation (orthonormal within 1e-6, determinant +1). `translation` is `t` in
-//! world units (metres in this crate). Unknown keys are ignored. [`Camera::load`] reports errors
-//! naming the file and the field (for example `intrinsics.fx`).
+//! The JSON camera file (see the [camera module](super) for the format): its serde layout,
+//! validation of a [`Camera`]'s invariants, reading with errors that name the file and the
+//! field, and writing.
 
 use std::path::{Path, PathBuf};
 
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
+
+use super::Camera;
 
 /// Largest deviation of `RᵀR` from the identity (and of `det R` from 1) accepted for a rotation.
 pub const ORTHONORMAL_TOLERANCE: f64 = 1e-6;
@@ -123,32 +99,7 @@ pub enum CameraError {
     },
 }
 
-/// A calibrated pinhole camera with radial distortion; see the [module docs](self) for the model.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Camera {
-    /// Horizontal focal length, pixels.
-    pub fx: f64,
-    /// Vertical focal length, pixels.
-    pub fy: f64,
-    /// Principal point, x, pixels.
-    pub cx: f64,
-    /// Principal point, y, pixels.
-    pub cy: f64,
-    /// First radial distortion coefficient (of `r²`).
-    pub k1: f64,
-    /// Second radial distortion coefficient (of `r⁴`).
-    pub k2: f64,
-    /// World→camera rotation.
-    pub rotation: Matrix3<f64>,
-    /// World→camera translation: `pc = rotation · p + translation`.
-    pub translation: Vector3<f64>,
-    /// Image width, pixels.
-    pub width: u32,
-    /// Image height, pixels.
-    pub height: u32,
-}
-
-/// Intrinsic part of the camera file (see the [module docs](self)).
+/// Intrinsic part of the camera file (see the [camera module](super)).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct IntrinsicsFile {
     /// Horizontal focal length, pixels.
@@ -169,7 +120,7 @@ pub struct IntrinsicsFile {
     pub height: u32,
 }
 
-/// Extrinsic part of the camera file (see the [module docs](self)).
+/// Extrinsic part of the camera file (see the [camera module](super)).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ExtrinsicsFile {
     /// World→camera rotation, row-major.
@@ -178,20 +129,20 @@ pub struct ExtrinsicsFile {
     pub translation: [f64; 3],
 }
 
-/// The camera file as plain serde data (see the [module docs](self)). Deserialising this
+/// The camera file as plain serde data (see the [camera module](super)). Deserialising this
 /// directly skips validation; [`Camera::from_json`] validates and gives better messages.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CameraFile {
+pub struct JsonCamera {
     /// Focal lengths, principal point, distortion and image size.
     pub intrinsics: IntrinsicsFile,
     /// Pose: world→camera rotation and translation.
     pub extrinsics: ExtrinsicsFile,
 }
 
-impl From<&Camera> for CameraFile {
+impl From<&Camera> for JsonCamera {
     fn from(c: &Camera) -> Self {
         let r = &c.rotation;
-        CameraFile {
+        JsonCamera {
             intrinsics: IntrinsicsFile {
                 fx: c.fx,
                 fy: c.fy,
@@ -214,8 +165,8 @@ impl From<&Camera> for CameraFile {
     }
 }
 
-impl From<&CameraFile> for Camera {
-    fn from(f: &CameraFile) -> Self {
+impl From<&JsonCamera> for Camera {
+    fn from(f: &JsonCamera) -> Self {
         let r = &f.extrinsics.rotation;
         let t = &f.extrinsics.translation;
         Camera {
@@ -236,165 +187,6 @@ impl From<&CameraFile> for Camera {
 }
 
 impl Camera {
-    /// A camera without distortion from focal lengths, principal point, pose and image size.
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        fx: f64,
-        fy: f64,
-        cx: f64,
-        cy: f64,
-        rotation: Matrix3<f64>,
-        translation: Vector3<f64>,
-        width: u32,
-        height: u32,
-    ) -> Self {
-        Camera {
-            fx,
-            fy,
-            cx,
-            cy,
-            k1: 0.0,
-            k2: 0.0,
-            rotation,
-            translation,
-            width,
-            height,
-        }
-    }
-
-    /// A camera without distortion at `eye` looking at `target`, the world's +y up in the image
-    /// (image x towards +x when looking along −z), square pixels of focal length `focal`,
-    /// principal point at the image centre.
-    pub fn looking_at(
-        eye: Vector3<f64>,
-        target: Vector3<f64>,
-        focal: f64,
-        width: u32,
-        height: u32,
-    ) -> Camera {
-        Camera::looking_at_up(eye, target, Vector3::y(), focal, width, height)
-    }
-
-    /// [`Camera::looking_at`] with `up` (a world direction, not along the view) up in the
-    /// image: the z-up worlds of the tracking sequences pass +z.
-    pub fn looking_at_up(
-        eye: Vector3<f64>,
-        target: Vector3<f64>,
-        up: Vector3<f64>,
-        focal: f64,
-        width: u32,
-        height: u32,
-    ) -> Camera {
-        let f = (target - eye).normalize();
-        let right = f.cross(&up).normalize();
-        let down = f.cross(&right);
-        let rotation = Matrix3::from_rows(&[right.transpose(), down.transpose(), f.transpose()]);
-        Camera::new(
-            focal,
-            focal,
-            (width as f64 - 1.0) / 2.0,
-            (height as f64 - 1.0) / 2.0,
-            rotation,
-            -(rotation * eye),
-            width,
-            height,
-        )
-    }
-
-    /// The intrinsic matrix `K = [[fx, 0, cx], [0, fy, cy], [0, 0, 1]]`.
-    pub fn k_matrix(&self) -> Matrix3<f64> {
-        Matrix3::new(self.fx, 0.0, self.cx, 0.0, self.fy, self.cy, 0.0, 0.0, 1.0)
-    }
-
-    /// Camera centre in world coordinates, `−Rᵀ t`.
-    pub fn center(&self) -> Vector3<f64> {
-        -(self.rotation.transpose() * self.translation)
-    }
-
-    /// A world point in the camera frame, `R p + t`.
-    pub fn to_camera_frame(&self, p: &Vector3<f64>) -> Vector3<f64> {
-        self.rotation * p + self.translation
-    }
-
-    /// Applies the radial distortion to ideal normalised coordinates `(x, y)` (`X/Z, Y/Z`).
-    pub fn distort(&self, xy: [f64; 2]) -> [f64; 2] {
-        let r2 = xy[0] * xy[0] + xy[1] * xy[1];
-        let f = 1.0 + self.k1 * r2 + self.k2 * r2 * r2;
-        [xy[0] * f, xy[1] * f]
-    }
-
-    /// Inverts [`distort`](Self::distort): ideal normalised coordinates from distorted ones, by
-    /// Newton iteration on the radius. Exact to ~1e-14 inside the region where the distortion is
-    /// monotonic; outside it returns the best iterate found.
-    pub fn undistort(&self, xy: [f64; 2]) -> [f64; 2] {
-        let rd = (xy[0] * xy[0] + xy[1] * xy[1]).sqrt();
-        if rd == 0.0 || (self.k1 == 0.0 && self.k2 == 0.0) {
-            return xy;
-        }
-        // solve g(r) = r (1 + k1 r² + k2 r⁴) − rd = 0
-        let mut r = rd;
-        for _ in 0..50 {
-            let r2 = r * r;
-            let g = r * (1.0 + self.k1 * r2 + self.k2 * r2 * r2) - rd;
-            let dg = 1.0 + 3.0 * self.k1 * r2 + 5.0 * self.k2 * r2 * r2;
-            if dg.abs() < 1e-12 {
-                break;
-            }
-            let step = g / dg;
-            r -= step;
-            if step.abs() <= 1e-15 * rd.max(1e-300) {
-                break;
-            }
-        }
-        let s = r / rd;
-        [xy[0] * s, xy[1] * s]
-    }
-
-    /// Pixel → ideal normalised coordinates (`X/Z, Y/Z` in the camera frame), removing distortion.
-    pub fn undistort_pixel_to_normalized(&self, uv: [f64; 2]) -> [f64; 2] {
-        self.undistort([(uv[0] - self.cx) / self.fx, (uv[1] - self.cy) / self.fy])
-    }
-
-    /// The pixel where the point would appear with the same `K` but no distortion.
-    pub fn undistorted_pixel(&self, uv: [f64; 2]) -> [f64; 2] {
-        let n = self.undistort_pixel_to_normalized(uv);
-        [self.fx * n[0] + self.cx, self.fy * n[1] + self.cy]
-    }
-
-    /// Projects a camera-frame point without checking that it is in front (divides by `z`).
-    pub(crate) fn project_camera_frame_unchecked(&self, pc: &Vector3<f64>) -> [f64; 2] {
-        let d = self.distort([pc.x / pc.z, pc.y / pc.z]);
-        [self.fx * d[0] + self.cx, self.fy * d[1] + self.cy]
-    }
-
-    /// Projects a world point to pixels (distortion included); `None` when the point is not in
-    /// front of the camera (`z ≤ 0` in the camera frame). Points outside the image are still
-    /// projected: compare with [`width`](Self::width)/[`height`](Self::height) if that matters.
-    pub fn project(&self, p: &Vector3<f64>) -> Option<[f64; 2]> {
-        let pc = self.to_camera_frame(p);
-        if pc.z.is_nan() || pc.z <= 0.0 {
-            return None;
-        }
-        Some(self.project_camera_frame_unchecked(&pc))
-    }
-
-    /// The same camera for an image pyramid level shrunk by `factor` (2 = half size): focal
-    /// lengths divided by `factor`, principal point `c' = (c + 0.5) / factor − 0.5` (pixel
-    /// centres stay consistent), width and height divided and rounded (at least 1); distortion
-    /// and pose unchanged.
-    pub fn scaled(&self, factor: f64) -> Camera {
-        let size = |n: u32| ((n as f64 / factor).round().max(1.0)) as u32;
-        Camera {
-            fx: self.fx / factor,
-            fy: self.fy / factor,
-            cx: (self.cx + 0.5) / factor - 0.5,
-            cy: (self.cy + 0.5) / factor - 0.5,
-            width: size(self.width),
-            height: size(self.height),
-            ..self.clone()
-        }
-    }
-
     /// Checks the invariants of the file format (finite values, positive focal lengths and image
     /// size, proper rotation); `source` names the camera in the error.
     pub fn validate_named(&self, source: &str) -> Result<(), CameraError> {
@@ -476,7 +268,7 @@ impl Camera {
     /// The camera as pretty-printed JSON in the documented format, after validation.
     pub fn to_json(&self) -> Result<String, CameraError> {
         self.validate()?;
-        serde_json::to_string_pretty(&CameraFile::from(self)).map_err(|e| CameraError::Json {
+        serde_json::to_string_pretty(&JsonCamera::from(self)).map_err(|e| CameraError::Json {
             origin: "camera".into(),
             message: e.to_string(),
         })
@@ -682,62 +474,15 @@ mod tests {
     }
 
     #[test]
-    fn undistort_inverts_distort() {
-        let c = cam();
-        for &p in &[[0.0, 0.0], [0.3, -0.2], [-0.5, 0.4], [0.01, 0.0]] {
-            let d = c.distort(p);
-            let u = c.undistort(d);
-            assert!(
-                (u[0] - p[0]).abs() < 1e-13 && (u[1] - p[1]).abs() < 1e-13,
-                "{p:?} {u:?}"
-            );
-        }
-    }
-
-    #[test]
-    fn behind_camera_is_none_and_centre_projects_to_principal_point() {
-        let c = cam();
-        assert!(c.project(&Vector3::new(0.0, 0.0, -1.0)).is_none());
-        assert!(c.project(&Vector3::new(0.0, 0.0, 0.0)).is_none());
-        let uv = c.project(&Vector3::new(0.0, 0.0, 2.0)).expect("in front");
-        assert_eq!(uv, [162.0, 118.0]);
-        assert_eq!(c.center(), Vector3::zeros());
-    }
-
-    #[test]
     fn json_null_is_not_finite_and_names_field() {
         let mut c = cam();
         c.cx = f64::NAN;
-        let text = serde_json::to_string(&CameraFile::from(&c)).expect("serialises");
+        let text = serde_json::to_string(&JsonCamera::from(&c)).expect("serialises");
         let err = Camera::from_json_named(&text, "x.json").expect_err("NaN must fail");
         let msg = err.to_string();
         assert!(
             msg.contains("x.json") && msg.contains("intrinsics.cx"),
             "{msg}"
         );
-    }
-
-    #[test]
-    fn scaled_camera_maps_pixel_areas_consistently() {
-        let c = cam();
-        let h = c.scaled(2.0);
-        assert_eq!((h.width, h.height), (160, 120));
-        assert_eq!((h.fx, h.fy), (200.0, 200.5));
-        assert_eq!((h.cx, h.cy), (80.75, 58.75));
-        assert_eq!(
-            (h.k1, h.k2, h.rotation, h.translation),
-            (c.k1, c.k2, c.rotation, c.translation)
-        );
-        let p = Vector3::new(0.3, -0.2, 2.5);
-        let (a, b) = (c.project(&p).expect("front"), h.project(&p).expect("front"));
-        // a full-resolution pixel u covers [u − 0.5, u + 0.5]; at half size that is (u + 0.5) / 2 − 0.5
-        for i in 0..2 {
-            assert!(
-                ((a[i] + 0.5) / 2.0 - 0.5 - b[i]).abs() < 1e-12,
-                "{a:?} {b:?}"
-            );
-        }
-        assert_eq!(c.scaled(1.0), c);
-        assert_eq!(c.scaled(3.0).width, 107);
     }
 }

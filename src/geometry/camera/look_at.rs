@@ -1,8 +1,16 @@
-//! `Camera`: a pinhole perspective camera (eye, target, up, vertical field of view, image
-//! size), with automatic framing of a bounding box and projection of points to pixels.
+//! [`LookAtCamera`]: a camera placed the way a person frames a picture (eye, target, up,
+//! vertical field of view, image size), with automatic framing of a bounding box; what the
+//! renderer and the scripts' `render` take. It describes the same pinhole model as
+//! [`Camera`] (no distortion, square pixels, principal point at the image centre) and
+//! converts to one ([`LookAtCamera::to_camera`]); the renderer projects through its own frame
+//! ([`LookAtCamera::project`]: `R (p − eye)` and pixel corners at integers), the arithmetic its
+//! pictures have always had.
 
 use serde::{Deserialize, Serialize};
 
+use nalgebra::Matrix3;
+
+use super::Camera;
 use crate::geometry::Vec3;
 
 /// Distance (m) of the near clipping plane in front of the eye: closer points are not drawn.
@@ -15,7 +23,7 @@ pub const MAX_SIZE: u32 = 16384;
 /// pixel centres are at half-integer coordinates.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
-pub struct Camera {
+pub struct LookAtCamera {
     /// Position of the eye (m).
     pub eye: Vec3,
     /// Point the camera looks at (m); it projects to the image centre.
@@ -30,10 +38,10 @@ pub struct Camera {
     pub height: u32,
 }
 
-impl Default for Camera {
+impl Default for LookAtCamera {
     /// An 800 × 600, 40° camera looking at the origin from +x, −y, above.
     fn default() -> Self {
-        Camera {
+        LookAtCamera {
             eye: Vec3::new(1.6, -2.4, 1.3),
             target: Vec3::zeros(),
             up: Vec3::z(),
@@ -80,13 +88,13 @@ impl Frame {
     }
 }
 
-impl Camera {
+impl LookAtCamera {
     /// A default-sized camera (800 × 600, 40°, Z up) at `eye` looking at `target`.
-    pub fn look_at(eye: Vec3, target: Vec3) -> Camera {
-        Camera {
+    pub fn look_at(eye: Vec3, target: Vec3) -> LookAtCamera {
+        LookAtCamera {
             eye,
             target,
-            ..Camera::default()
+            ..LookAtCamera::default()
         }
     }
 
@@ -94,7 +102,7 @@ impl Camera {
     /// `bounds_min`..`bounds_max` (from +x, −y and above, Z up), aimed so that the box's image
     /// is centred, from just far enough that the whole box fits with a 5 % margin on each side. Non-finite or
     /// inverted bounds frame a unit cube at the origin.
-    pub fn framing(bounds_min: Vec3, bounds_max: Vec3, width: u32, height: u32) -> Camera {
+    pub fn framing(bounds_min: Vec3, bounds_max: Vec3, width: u32, height: u32) -> LookAtCamera {
         let ok = bounds_min
             .iter()
             .chain(bounds_max.iter())
@@ -107,7 +115,7 @@ impl Camera {
         };
         let center = 0.5 * (lo + hi);
         let radius = (0.5 * (hi - lo).norm()).max(1e-3);
-        let mut cam = Camera {
+        let mut cam = LookAtCamera {
             eye: center + Vec3::new(0.9, -1.4, 0.8).normalize(),
             target: center,
             up: Vec3::z(),
@@ -217,6 +225,30 @@ impl Camera {
         let (x, y) = f.pixel(&c);
         Some((x, y, c.z))
     }
+
+    /// The same view as a pinhole [`Camera`] (`None` when unusable, see `frame`): rotation
+    /// rows right, down, forward; `t = −R eye`; square pixels of the focal length the field
+    /// of view gives; principal point at the image centre in the [`Camera`]'s pixel-centre
+    /// convention (`(w − 1) / 2, (h − 1) / 2`); no distortion; the clamped image size. Its
+    /// projection matches [`project`](Self::project) up to rounding, shifted by half a
+    /// pixel (pixel centres at integers instead of half-integers).
+    pub fn to_camera(&self) -> Option<Camera> {
+        let f = self.frame()?;
+        let down = -f.up;
+        let rotation =
+            Matrix3::from_rows(&[f.right.transpose(), down.transpose(), f.forward.transpose()]);
+        let (w, h) = self.size();
+        Some(Camera::new(
+            f.focal,
+            f.focal,
+            f.cx - 0.5,
+            f.cy - 0.5,
+            rotation,
+            -(rotation * f.eye),
+            w,
+            h,
+        ))
+    }
 }
 
 #[cfg(test)]
@@ -225,7 +257,7 @@ mod tests {
 
     #[test]
     fn target_projects_to_centre_and_behind_is_none() {
-        let cam = Camera::look_at(Vec3::new(3.0, -2.0, 1.0), Vec3::new(0.1, 0.2, 0.3));
+        let cam = LookAtCamera::look_at(Vec3::new(3.0, -2.0, 1.0), Vec3::new(0.1, 0.2, 0.3));
         let (x, y, d) = cam.project(cam.target).unwrap();
         assert!((x - 400.0).abs() < 1e-9 && (y - 300.0).abs() < 1e-9);
         assert!((d - (cam.target - cam.eye).norm()).abs() < 1e-9);
@@ -235,14 +267,14 @@ mod tests {
         assert!(cam.project(cam.eye * 2.0 - cam.target).is_none());
         assert!(cam.project(Vec3::new(f64::NAN, 0.0, 0.0)).is_none());
         // Looking straight down still works (up falls back).
-        let down = Camera::look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::zeros());
+        let down = LookAtCamera::look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::zeros());
         assert!(down.project(Vec3::new(0.1, 0.0, 0.0)).is_some());
     }
 
     #[test]
     fn framing_keeps_the_box_in_view() {
         let (lo, hi) = (Vec3::new(-0.5, -0.25, -0.8), Vec3::new(0.5, 0.25, 0.0));
-        let cam = Camera::framing(lo, hi, 640, 480);
+        let cam = LookAtCamera::framing(lo, hi, 640, 480);
         let mut ext = [f64::INFINITY, -f64::INFINITY, f64::INFINITY, -f64::INFINITY];
         for k in 0..8 {
             let c = Vec3::new(
@@ -265,8 +297,19 @@ mod tests {
             "{ext:?}"
         );
         let json = serde_json::to_string(&cam).unwrap();
-        assert_eq!(serde_json::from_str::<Camera>(&json).unwrap(), cam);
-        let bad = Camera::framing(Vec3::repeat(f64::NAN), Vec3::zeros(), 10, 10);
+        assert_eq!(serde_json::from_str::<LookAtCamera>(&json).unwrap(), cam);
+        let pinhole = cam.to_camera().unwrap();
+        for k in 0..8 {
+            let c = Vec3::new(
+                [lo.x, hi.x][k & 1],
+                [lo.y, hi.y][(k >> 1) & 1],
+                [lo.z, hi.z][k >> 2],
+            );
+            let (x, y, _) = cam.project(c).unwrap();
+            let uv = pinhole.project(&c).unwrap();
+            assert!((uv[0] + 0.5 - x).abs() < 1e-9 && (uv[1] + 0.5 - y).abs() < 1e-9);
+        }
+        let bad = LookAtCamera::framing(Vec3::repeat(f64::NAN), Vec3::zeros(), 10, 10);
         assert!(bad.project(Vec3::zeros()).is_some());
     }
 }
