@@ -9,7 +9,8 @@
 //! overlays ([`overlay`]), rule files, 3D facades ([`facade_mesh`], [`facade_export`])). The
 //! evaluation: label maps in canonical classes ([`labels`]), window instances ([`instances`]),
 //! pixel and window-detection scores ([`score`], protocol of `facade-reconstruction.md` §4) and
-//! folder reports ([`report`]).
+//! folder reports ([`report`]). Photos are read as the grey images of
+//! [`crate::geometry::image`].
 
 pub mod analysis;
 pub mod assignment;
@@ -19,7 +20,6 @@ pub mod error;
 pub mod facade_export;
 pub mod facade_mesh;
 pub mod grammar;
-pub mod gray;
 pub mod homography;
 pub mod instances;
 pub mod labels;

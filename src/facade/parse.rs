@@ -7,7 +7,6 @@
 use std::time::Instant;
 
 use super::grammar::{Grammar, Leaf};
-use super::gray::Gray;
 use super::labels::{Class, LabelMap};
 use super::parse_grammar::grammar_of;
 use super::rect::Rect;
@@ -17,6 +16,7 @@ use super::score::PixelScore;
 use super::tile_refinement::{measure, Refinement};
 use super::window_blobs::{detect_windows, BlobParams};
 use super::window_grammar::grammar_of_windows;
+use crate::geometry::image::Gray;
 
 /// Priors of the parse, as fractions of the image's extent.
 #[derive(Debug, Clone, Copy, PartialEq)]

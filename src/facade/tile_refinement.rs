@@ -15,9 +15,9 @@
 use std::collections::BTreeMap;
 
 use super::grammar::{Body, Dir, Size};
-use super::gray::Gray;
 use super::labels::Class;
 use super::rect::Rect;
+use crate::geometry::image::Gray;
 
 /// Where a facade's windows' sides lie, and the frame width and sill height round them
 /// (pixels; 0: none).

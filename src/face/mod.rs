@@ -15,8 +15,8 @@
 //!   the signed error map between two surfaces;
 //! - [`head_pose`], [`skin`], [`sequence`], [`sequence_files`]: synthetic sequences with ground
 //!   truth (pose and FAP trajectories) and reading sequence folders;
-//! - [`gray`], [`samples`], [`tracker`], [`track_run`]: tracking of head pose and expression,
-//!   and its outputs.
+//! - [`samples`], [`tracker`], [`track_run`]: tracking of head pose and expression (on the grey
+//!   images of [`crate::geometry::image`]), and its outputs.
 
 pub mod adapt;
 pub mod align;
@@ -29,7 +29,6 @@ pub mod export;
 pub mod expressions;
 pub mod fap;
 pub mod fit_run;
-pub mod gray;
 pub mod head_pose;
 pub mod landmarks;
 pub mod model;

@@ -1,11 +1,13 @@
 //! Geometry: triangle meshes with rest (pattern) coordinates, grid generators, edge/hinge
-//! adjacency, and mesh file I/O (OBJ read/write, binary glTF write).
+//! adjacency, mesh file I/O (OBJ read/write, binary glTF write), grey images and their filters
+//! ([`image`]) and seeded random numbers ([`random`]).
 
 pub mod cone;
 pub mod error;
 pub(crate) mod files;
 pub mod gltf;
 pub mod grid;
+pub mod image;
 pub mod mesh;
 pub mod obj;
 pub mod random;
@@ -17,7 +19,7 @@ pub use gltf::write_glb;
 pub use grid::grid_mesh;
 pub use mesh::TriMesh;
 pub use obj::{read_obj, read_obj_surface, write_obj};
-pub use random::SplitMix64;
+pub use random::{Lcg64, SplitMix64};
 pub use topology::{Edge, Hinge, Topology};
 
 /// Three-vector of f64, SI units (metres, m/s, newtons).
