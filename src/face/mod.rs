@@ -13,8 +13,8 @@
 //!   adaptation of the generic mesh to a person's photos, and its outputs;
 //! - [`texture_bake`], [`export`], [`error_map`]: texture from photos, OBJ+MTL and glTF files,
 //!   the signed error map between two surfaces;
-//! - [`head_pose`], [`skin`], [`sequence`], [`sequence_files`]: synthetic sequences with ground
-//!   truth (pose and FAP trajectories) and reading sequence folders;
+//! - [`head_pose`], [`skin`], [`sequence`], [`sequence_options`], [`sequence_files`]: synthetic
+//!   sequences with ground truth (pose and FAP trajectories) and reading sequence folders;
 //! - [`samples`], [`tracker`], [`track_run`]: tracking of head pose and expression (on the grey
 //!   images of [`crate::geometry::image`]), and its outputs.
 
@@ -40,6 +40,7 @@ pub mod render;
 pub mod samples;
 pub mod sequence;
 pub mod sequence_files;
+pub mod sequence_options;
 pub mod skin;
 pub mod texture_bake;
 pub mod track_run;
