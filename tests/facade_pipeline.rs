@@ -12,7 +12,7 @@ use common::{facade, noise, window_truth, FLOOR, TILE};
 use emilion::facade::analysis::{analyze, Options, Rectify};
 use emilion::facade::homography::{warp_gray, warp_labels, Homography};
 use emilion::facade::outputs::{write_outputs, OutputOptions};
-use emilion::facade::parse::{rasterize, round_trip};
+use emilion::facade::rasterize::{rasterize, round_trip};
 use emilion::facade::{Class, LabelMap, PixelScore};
 use emilion::geometry::image::Gray;
 use emilion::geometry::read_obj_surface;

@@ -17,7 +17,7 @@ use super::facade_mesh::{build, check_closed, FacadeMesh, MeshParams};
 use super::grammar::Grammar;
 use super::labels::{Class, LabelMap};
 use super::overlay;
-use super::parse::rasterize;
+use super::rasterize::rasterize;
 use super::segments;
 use crate::geometry::Vec3;
 use crate::render::{render_png, Camera, RenderMesh};
