@@ -5,12 +5,12 @@
 //! analysis stage; prints one line per photo and the share within 10 %.
 use std::path::PathBuf;
 
-use emilion::facade::gray::Gray;
 use emilion::facade::instances::window_instances;
 use emilion::facade::repetition::{detect, Axis};
 use emilion::facade::report::labelled_images;
 use emilion::facade::structure::WindowGrid;
 use emilion::facade::LabelMap;
+use emilion::geometry::image::Gray;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let dir = std::env::args()

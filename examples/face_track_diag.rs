@@ -1,8 +1,9 @@
 //! Diagnostics of the face tracker on a synthetic sequence: per-frame pose and FAP errors.
 //! `cargo run --release --example face_track_diag -- OUT_DIR [frames] [rigid]`
 
-use emilion::face::sequence::{make_face_sequence, FaceSequenceOptions};
+use emilion::face::sequence::make_face_sequence;
 use emilion::face::sequence_files::FaceSequence;
+use emilion::face::sequence_options::FaceSequenceOptions;
 use emilion::face::tracker::{FaceTracker, FaceTrackerOptions};
 use std::path::Path;
 

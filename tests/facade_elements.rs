@@ -11,11 +11,11 @@ use emilion::facade::element_library::{insert_elements, Library};
 use emilion::facade::element_match::recognise_elements;
 use emilion::facade::facade_mesh::{build, check_closed, MeshParams, Surface};
 use emilion::facade::grammar::Grammar;
-use emilion::facade::gray::Gray;
 use emilion::facade::parse::{parse, Priors};
-use emilion::facade::tile_refinement::Refinement;
+use emilion::facade::refinement::Refinement;
 use emilion::facade::window_grammar::grammar_of_windows;
 use emilion::facade::{Class, Rect};
+use emilion::geometry::image::Gray;
 
 #[test]
 fn windows_drawn_from_each_element_are_recognised_and_inserted() {

@@ -7,7 +7,8 @@ mod common;
 
 use common::{facade, window_truth, FLOOR, TILE};
 use emilion::facade::grammar::Grammar;
-use emilion::facade::parse::{parse, rasterize, Priors};
+use emilion::facade::parse::{parse, Priors};
+use emilion::facade::rasterize::rasterize;
 use emilion::facade::{Class, PixelScore};
 
 #[test]

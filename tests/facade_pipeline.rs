@@ -10,11 +10,11 @@ use std::path::{Path, PathBuf};
 
 use common::{facade, noise, window_truth, FLOOR, TILE};
 use emilion::facade::analysis::{analyze, Options, Rectify};
-use emilion::facade::gray::Gray;
 use emilion::facade::homography::{warp_gray, warp_labels, Homography};
 use emilion::facade::outputs::{write_outputs, OutputOptions};
-use emilion::facade::parse::{rasterize, round_trip};
+use emilion::facade::rasterize::{rasterize, round_trip};
 use emilion::facade::{Class, LabelMap, PixelScore};
+use emilion::geometry::image::Gray;
 use emilion::geometry::read_obj_surface;
 use nalgebra::Matrix3;
 

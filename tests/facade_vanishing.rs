@@ -10,12 +10,12 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use common::{facade, FLOOR, TILE, WIN_X, WIN_Y};
-use emilion::facade::gray::Gray;
 use emilion::facade::homography::{warp_gray, warp_labels, Homography};
 use emilion::facade::instances::window_instances;
 use emilion::facade::report::labelled_images;
 use emilion::facade::vanishing::{rectify, Rectification};
 use emilion::facade::{Class, FacadeError, LabelMap};
+use emilion::geometry::image::Gray;
 use nalgebra::Matrix3;
 
 /// Facade size: 7 tiles × 4 floors and a bit.

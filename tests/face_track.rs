@@ -4,8 +4,9 @@
 
 use std::path::{Path, PathBuf};
 
-use emilion::face::sequence::{make_face_sequence, FaceSequenceOptions};
+use emilion::face::sequence::make_face_sequence;
 use emilion::face::sequence_files::FaceSequence;
+use emilion::face::sequence_options::FaceSequenceOptions;
 use emilion::face::track_run::{track_face_sequence, write_face_track_outputs};
 use emilion::face::tracker::FaceTrackerOptions;
 

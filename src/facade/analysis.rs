@@ -12,11 +12,12 @@ use super::element_library::Library;
 use super::element_match::{recognise_elements, ElementMatch};
 use super::error::FacadeError;
 use super::grammar::Grammar;
-use super::gray::{read_rgb, Gray};
 use super::homography::{warp_rgb, Homography};
-use super::parse::{parse_region, Priors, Structure};
+use super::parse::{parse_region, Priors};
+use super::parse_structure::Structure;
 use super::rect::Rect;
 use super::vanishing::rectify;
+use crate::geometry::image::{read_rgb, Gray};
 
 /// How the photo is brought to a fronto-parallel view.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -91,6 +91,7 @@ pub fn min_cost_assignment(cost: &[f64], rows: usize, cols: usize) -> Vec<Option
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::Lcg64;
 
     /// Brute force over all injective assignments of a small matrix.
     fn brute(cost: &[f64], rows: usize, cols: usize) -> f64 {
@@ -118,13 +119,8 @@ mod tests {
 
     #[test]
     fn assignment_is_optimal_on_small_matrices() {
-        let mut s = 12345u64;
-        let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 33) as f64 / (1u64 << 31) as f64
-        };
+        let mut rng = Lcg64::new(12345);
+        let mut rnd = || (rng.next_u64() >> 33) as f64 / (1u64 << 31) as f64;
         for (rows, cols) in [(3, 3), (2, 5), (5, 2), (4, 4), (1, 3), (4, 1)] {
             for _ in 0..20 {
                 let cost: Vec<f64> = (0..rows * cols).map(|_| rnd()).collect();

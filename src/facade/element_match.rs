@@ -17,10 +17,11 @@
 
 use super::element_library::Library;
 use super::grammar::{Body, Grammar};
-use super::gray::Gray;
 use super::labels::Class;
 use super::rect::Rect;
 use super::window_grammar::MIN_GROUP;
+use crate::geometry::image::filters::box_mean_3x3;
+use crate::geometry::image::Gray;
 
 /// Side of the grid every instance is resampled to (even: its centre lies between cells).
 pub const GRID: usize = 24;
@@ -116,21 +117,13 @@ fn shifted(v: &[f64], (dx, dy): (isize, isize)) -> Vec<f64> {
 
 /// A `GRID` × `GRID` grid averaged over each cell's 3 × 3 neighbourhood (clamped at the
 /// border).
-fn blurred(v: &[f64]) -> Vec<f64> {
-    let n = GRID as isize;
-    let at = |i: isize, j: isize| v[(j.clamp(0, n - 1) * n + i.clamp(0, n - 1)) as usize];
-    (0..n * n)
-        .map(|k| {
-            let (i, j) = (k % n, k / n);
-            let mut s = 0.0;
-            for dj in -1..=1 {
-                for di in -1..=1 {
-                    s += at(i + di, j + dj);
-                }
-            }
-            s / 9.0
-        })
-        .collect()
+fn blurred(v: Vec<f64>) -> Vec<f64> {
+    let grid = Gray {
+        width: GRID as u32,
+        height: GRID as u32,
+        data: v,
+    };
+    box_mean_3x3(grid).data
 }
 
 /// Squared correlation of `a` and `b` (0 when either is flat).
@@ -218,7 +211,7 @@ pub fn recognise(
             let best = shifts
                 .iter()
                 .map(|&shift| {
-                    let view = blurred(&blurred(&shifted(&mask, shift)));
+                    let view = blurred(blurred(shifted(&mask, shift)));
                     r_squared(&seen, &pick(&view))
                 })
                 .fold(0.0, f64::max);

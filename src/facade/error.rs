@@ -2,6 +2,8 @@
 
 use std::path::PathBuf;
 
+use crate::geometry::GeometryError;
+
 /// What can go wrong reading or scoring facades.
 #[derive(Debug, thiserror::Error)]
 pub enum FacadeError {
@@ -38,4 +40,30 @@ pub enum FacadeError {
         /// Why.
         message: String,
     },
+}
+
+impl From<GeometryError> for FacadeError {
+    /// A geometry-layer error (a photo or label image that cannot be read) as a file error
+    /// naming the file.
+    fn from(e: GeometryError) -> Self {
+        match e {
+            GeometryError::Image { path, message } => FacadeError::File { path, message },
+            GeometryError::Io { path, source } => FacadeError::File {
+                path,
+                message: source.to_string(),
+            },
+            GeometryError::Parse {
+                path,
+                line,
+                message,
+            } => FacadeError::File {
+                path,
+                message: format!("line {line}: {message}"),
+            },
+            GeometryError::Invalid(message) => FacadeError::File {
+                path: PathBuf::new(),
+                message,
+            },
+        }
+    }
 }

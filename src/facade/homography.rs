@@ -6,8 +6,8 @@
 use image::RgbImage;
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
-use super::gray::Gray;
 use super::labels::{Class, LabelMap};
+use crate::geometry::image::Gray;
 
 /// A 3×3 homography acting on homogeneous pixel coordinates (x, y, 1).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -5,6 +5,8 @@
 
 use super::labels::{Class, LabelMap};
 use super::rect::Rect;
+use crate::geometry::image::morphology::open_3x3;
+use crate::geometry::image::{components, Connectivity};
 
 /// Smallest component kept, as a share of the image.
 pub const MIN_AREA_SHARE: f64 = 0.0005;
@@ -22,85 +24,20 @@ pub struct Instance {
 pub fn window_instances(map: &LabelMap) -> Vec<Instance> {
     let (w, h) = (map.width as usize, map.height as usize);
     let mask: Vec<bool> = map.classes.iter().map(|c| *c == Class::Window).collect();
-    let opened = dilate(&erode(&mask, w, h), w, h);
+    let opened = open_3x3(&mask, w, h);
     let min_area = (MIN_AREA_SHARE * (w * h) as f64).ceil() as usize;
-    let mut seen = vec![false; w * h];
     let mut out = Vec::new();
-    let mut stack = Vec::new();
-    for start in 0..w * h {
-        if !opened[start] || seen[start] {
+    for c in components(&opened, w, h, Connectivity::Eight) {
+        if (c.pixels as usize) < min_area {
             continue;
         }
-        seen[start] = true;
-        stack.push(start);
-        let (mut x0, mut y0, mut x1, mut y1) = (w, h, 0, 0);
-        let mut area = 0;
-        while let Some(p) = stack.pop() {
-            let (x, y) = (p % w, p / w);
-            area += 1;
-            (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x + 1), y1.max(y + 1));
-            for dy in -1i64..=1 {
-                for dx in -1i64..=1 {
-                    let (nx, ny) = (x as i64 + dx, y as i64 + dy);
-                    if nx < 0 || ny < 0 || nx >= w as i64 || ny >= h as i64 {
-                        continue;
-                    }
-                    let q = ny as usize * w + nx as usize;
-                    if opened[q] && !seen[q] {
-                        seen[q] = true;
-                        stack.push(q);
-                    }
-                }
-            }
-        }
-        if area < min_area {
-            continue;
-        }
-        let rect = Rect {
-            x0: x0 as u32,
-            y0: y0 as u32,
-            x1: x1 as u32,
-            y1: y1 as u32,
-        };
+        let [x0, y0, x1, y1] = c.bbox;
+        let rect = Rect { x0, y0, x1, y1 };
         let ignored = map.count_in(&rect, Class::Ignore);
         out.push(Instance {
             rect,
             dont_care: 2 * ignored >= rect.area(),
         });
-    }
-    out
-}
-
-/// 3×3 erosion (pixels outside the image count as unset).
-fn erode(m: &[bool], w: usize, h: usize) -> Vec<bool> {
-    morph(m, w, h, true)
-}
-
-/// 3×3 dilation.
-fn dilate(m: &[bool], w: usize, h: usize) -> Vec<bool> {
-    morph(m, w, h, false)
-}
-
-fn morph(m: &[bool], w: usize, h: usize, erode: bool) -> Vec<bool> {
-    let mut out = vec![false; w * h];
-    for y in 0..h {
-        for x in 0..w {
-            let mut all = true;
-            let mut any = false;
-            for dy in -1i64..=1 {
-                for dx in -1i64..=1 {
-                    let (nx, ny) = (x as i64 + dx, y as i64 + dy);
-                    let v = nx >= 0
-                        && ny >= 0
-                        && nx < w as i64
-                        && ny < h as i64
-                        && m[ny as usize * w + nx as usize];
-                    all &= v;
-                    any |= v;
-                }
-            }
-            out[y * w + x] = if erode { all } else { any };
-        }
     }
     out
 }

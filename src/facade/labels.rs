@@ -101,7 +101,7 @@ impl LabelMap {
     /// Reads a LabelMeFacade label map (PNG, RGB or RGBA). Every pixel must carry one of the
     /// dataset's nine colours; the first that does not is named with the file.
     pub fn read_labelmefacade(path: &Path) -> Result<Self, FacadeError> {
-        let img = super::gray::read_rgb(path)?;
+        let img = crate::geometry::image::read_rgb(path)?;
         let (width, height) = img.dimensions();
         let mut classes = Vec::with_capacity(width as usize * height as usize);
         for (x, y, p) in img.enumerate_pixels() {

@@ -4,7 +4,7 @@
 //! MI = (1/N) Σ n_ab ln(N n_ab / (n_a n_b)). MI rather than a pixel difference, so that floors
 //! lit differently still match.
 
-use super::gray::Gray;
+use crate::geometry::image::Gray;
 
 /// Grey levels of the histograms.
 pub const BINS: usize = 32;
@@ -113,16 +113,12 @@ impl MiWorkspace {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::Lcg64;
 
     fn noise(width: u32, height: u32, seed: u64) -> Gray {
-        let mut s = seed;
+        let mut rng = Lcg64::new(seed);
         let data = (0..width * height)
-            .map(|_| {
-                s = s
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                (s >> 56) as u8
-            })
+            .map(|_| (rng.next_u64() >> 56) as u8)
             .collect();
         Gray {
             width,

@@ -17,7 +17,7 @@ use super::facade_mesh::{build, check_closed, FacadeMesh, MeshParams};
 use super::grammar::Grammar;
 use super::labels::{Class, LabelMap};
 use super::overlay;
-use super::parse::rasterize;
+use super::rasterize::rasterize;
 use super::segments;
 use crate::geometry::LookAtCamera;
 use crate::geometry::Vec3;

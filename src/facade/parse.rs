@@ -1,22 +1,23 @@
 //! Facade parsing (Müller et al. 2007 §2–3): a rectified photo → floors and tiles by mutual
 //! information ([`super::repetition`]), the irreducible tile (every repeated tile averaged, so
 //! occluders average out), the window inside it from the tile's edge profiles, and the shape
-//! grammar of the whole ([`super::grammar`]). [`rasterize`] turns a derived grammar back into a
-//! per-pixel parse for scoring.
+//! grammar of the whole ([`super::grammar`]).
 
 use std::time::Instant;
 
-use super::grammar::{Grammar, Leaf};
-use super::gray::Gray;
+use super::grammar::Grammar;
 use super::labels::{Class, LabelMap};
 use super::parse_grammar::grammar_of;
+use super::parse_structure::Structure;
+use super::rasterize::rasterize;
 use super::rect::Rect;
+use super::refinement::Refinement;
 use super::repetition::{detect, Axis};
-use super::report::FacadeParse;
 use super::score::PixelScore;
-use super::tile_refinement::{measure, Refinement};
+use super::tile_refinement::measure;
 use super::window_blobs::{detect_windows, BlobParams};
 use super::window_grammar::grammar_of_windows;
+use crate::geometry::image::Gray;
 
 /// Priors of the parse, as fractions of the image's extent.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,50 +38,6 @@ impl Default for Priors {
             window: (0.25, 0.85),
         }
     }
-}
-
-/// What the parse found, with the time per stage.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Structure {
-    /// Floor height and the rows of the floor splits.
-    pub floor: u32,
-    /// Floor split rows (first and last bound the repeated floors).
-    pub floor_splits: Vec<u32>,
-    /// Tile width.
-    pub tile: u32,
-    /// Tile split columns.
-    pub tile_splits: Vec<u32>,
-    /// The window within a cell of the final layout (cell pixels).
-    pub window: Rect,
-    /// First row and column of the cell layout (photo pixels) and its floors × tiles.
-    pub origin: (u32, u32),
-    /// Floors and tiles of the layout.
-    pub count: (usize, usize),
-    /// Boundaries of the floors (`count.0 + 1` rows) and of the tiles (`count.1 + 1` columns),
-    /// photo pixels: the regular comb moved, floor by floor and column by column, to where
-    /// the windows of that floor or column stand out most (Müller's synchronisation).
-    pub row_starts: Vec<f64>,
-    /// See `row_starts`.
-    pub col_starts: Vec<f64>,
-    /// Whether each cell (floor-major) holds the repeated tile: cells unlike the irreducible
-    /// tile (another building, sky, a shop front) keep plain wall.
-    pub present: Vec<bool>,
-    /// Repetition strength (relative MI) of the floors and of the tiles.
-    pub strength: (f64, f64),
-    /// The irreducible tile (mean of the repeated tiles), row-major, `tile × floor`.
-    pub irreducible: Vec<f64>,
-    /// The windows found one by one ([`super::window_blobs`]), photo pixels.
-    pub windows: Vec<Rect>,
-    /// Whether the grammar is that of `windows` ([`super::window_grammar`]): when the
-    /// layout's windows agree with them less than [`GRID_AGREEMENT`]; otherwise the grammar
-    /// is the layout's (floors and tiles that repeat).
-    pub from_windows: bool,
-    /// The frame and sill round the grammar's windows ([`super::tile_refinement`]), measured
-    /// over all of them (the grammar of windows found one by one measures each size's own).
-    pub refinement: Refinement,
-    /// Seconds spent in: floor search, tile search, irreducible tile, window (the layout's,
-    /// with synchronisation), windows one by one (with the choice of grammar and tile refinement).
-    pub seconds: [f64; 5],
 }
 
 /// Least window contrast of a cell, as a share of the irreducible tile's, for the cell to
@@ -536,45 +493,6 @@ fn layout(n: u32, phase: u32, period: u32, elem: (u32, u32)) -> (f64, usize, f64
     (0.0, 0, e0 as f64)
 }
 
-/// The pixel parse of derived leaves on a `width` × `height` grid: each pixel takes the class
-/// of the leaf containing its centre; windows are the window leaves' pixel rectangles.
-pub fn rasterize(leaves: &[Leaf], width: u32, height: u32) -> FacadeParse {
-    let mut labels = LabelMap::filled(width, height, Class::Wall);
-    let mut windows = Vec::new();
-    let px = |v: f64, n: u32| (v - 0.5).ceil().clamp(0.0, n as f64) as u32;
-    for l in leaves {
-        let r = Rect {
-            x0: px(l.scope.x0, width),
-            y0: px(l.scope.y0, height),
-            x1: px(l.scope.x1, width),
-            y1: px(l.scope.y1, height),
-        };
-        labels.paint(&r, l.class);
-        if l.class == Class::Window && r.area() > 0 {
-            windows.push(r);
-        }
-    }
-    FacadeParse { labels, windows }
-}
-
-/// The round trip of a grammar: its rule file read back and derived at `width` × `height`,
-/// rasterised, against the grammar's own rasterised derivation: the share of pixels that
-/// agree (1 when the rule file loses nothing).
-pub fn round_trip(g: &Grammar, width: u32, height: u32) -> Result<f64, String> {
-    let (w, h) = (width as f64, height as f64);
-    let own = rasterize(&g.derive(w, h)?, width, height);
-    let back = Grammar::parse(&g.to_text())?;
-    let again = rasterize(&back.derive(w, h)?, width, height);
-    let same = own
-        .labels
-        .classes
-        .iter()
-        .zip(&again.labels.classes)
-        .filter(|(a, b)| a == b)
-        .count();
-    Ok(same as f64 / own.labels.classes.len().max(1) as f64)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -597,37 +515,5 @@ mod tests {
             *v = 40.0;
         }
         assert_eq!(best_band(&p, (0.25, 0.85)), (8, 30));
-    }
-
-    #[test]
-    fn rasterize_takes_the_leaf_under_each_pixel_centre() {
-        use super::super::grammar::Scope;
-        let s = |x0, y0, x1, y1| Scope { x0, y0, x1, y1 };
-        let leaves = [
-            Leaf {
-                scope: s(0.0, 0.0, 4.0, 4.0),
-                class: Class::Wall,
-                source: s(0.0, 0.0, 4.0, 4.0),
-                element: None,
-            },
-            Leaf {
-                scope: s(1.4, 1.6, 2.6, 3.0),
-                class: Class::Window,
-                source: s(1.4, 1.6, 2.6, 3.0),
-                element: None,
-            },
-        ];
-        let p = rasterize(&leaves, 4, 4);
-        // centres 1.5 and 2.5 lie in [1.4, 2.6); rows 1.5 does not lie in [1.6, 3), 2.5 does
-        assert_eq!(
-            p.windows,
-            vec![Rect {
-                x0: 1,
-                y0: 2,
-                x1: 3,
-                y1: 3
-            }]
-        );
-        assert_eq!(p.labels.count(Class::Window), 2);
     }
 }

@@ -1,4 +1,4 @@
-//! The grammar of a parse ([`super::parse::Structure`]): margins around the floors × tiles
+//! The grammar of a parse ([`super::parse_structure::Structure`]): margins around the floors × tiles
 //! layout; each floor a band of windows between wall above and below, the band cut into
 //! cells that hold a window between wall (or plain wall where the cell has none), written as
 //! split/repeat rules ([`super::grammar`]) that regenerate the parse exactly at the photo's
@@ -8,9 +8,9 @@ use std::collections::BTreeMap;
 
 use super::grammar::{Body, Dir, Grammar, Size};
 use super::labels::Class;
-use super::parse::Structure;
+use super::parse_structure::Structure;
 use super::rect::Rect;
-use super::tile_refinement::{framed_window, Refinement};
+use super::refinement::{framed_window, Refinement};
 
 /// A rule name for `key` among the variants seen so far: `base` for the first, `base2`, … for
 /// the others.

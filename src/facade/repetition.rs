@@ -7,8 +7,9 @@
 
 use rayon::prelude::*;
 
-use super::gray::Gray;
 use super::mutual_information::MiWorkspace;
+use crate::geometry::image::filters::gaussian_smooth_1d;
+use crate::geometry::image::Gray;
 
 /// Which way the facade repeats.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -101,28 +102,7 @@ pub fn edge_profile(img: &Gray, axis: Axis, sigma: f64) -> Vec<f64> {
             }
         }
     }
-    gaussian(&raw, sigma)
-}
-
-/// `v` convolved with a normalised Gaussian of standard deviation `sigma` (clamped ends).
-fn gaussian(v: &[f64], sigma: f64) -> Vec<f64> {
-    if sigma <= 0.0 {
-        return v.to_vec();
-    }
-    let r = (3.0 * sigma).ceil() as i64;
-    let k: Vec<f64> = (-r..=r)
-        .map(|d| (-0.5 * (d as f64 / sigma).powi(2)).exp())
-        .collect();
-    let ks: f64 = k.iter().sum();
-    let n = v.len() as i64;
-    (0..n)
-        .map(|i| {
-            (-r..=r)
-                .map(|d| v[(i + d).clamp(0, n - 1) as usize] * k[(d + r) as usize])
-                .sum::<f64>()
-                / ks
-        })
-        .collect()
+    gaussian_smooth_1d(&raw, sigma)
 }
 
 /// Relative scores `(h, S, S/S_own)` of the candidate periods `hs`, each scored

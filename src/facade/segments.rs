@@ -10,7 +10,8 @@
 
 use std::f64::consts::PI;
 
-use super::gray::Gray;
+use crate::geometry::image::filters::{binomial_blur, sobel};
+use crate::geometry::image::Gray;
 
 /// A straight edge segment in continuous pixel coordinates.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -84,8 +85,7 @@ pub fn detect_with(img: &Gray, p: &SegmentParams) -> Vec<Segment> {
     if w < 5 || h < 5 || img.data.len() != w * h {
         return Vec::new();
     }
-    let blurred = blur(&img.data, w, h);
-    let (mag, ang) = gradients(&blurred, w, h);
+    let (mag, ang) = sobel(&binomial_blur(img));
     let thr = p.gradient_threshold.max(0.0) as f32;
     let diag = (w as f64).hypot(h as f64);
     let min_len = (p.min_length_share * diag).max(3.0);
@@ -215,59 +215,6 @@ fn fit(
         b: [cx + l1 * dx, cy + l1 * dy],
         strength: sw / region.len() as f64,
     })
-}
-
-/// Separable binomial blur [1 4 6 4 1]/16 (σ ≈ 1), borders clamped.
-fn blur(src: &[u8], w: usize, h: usize) -> Vec<f32> {
-    const K: [f32; 5] = [1.0 / 16.0, 4.0 / 16.0, 6.0 / 16.0, 4.0 / 16.0, 1.0 / 16.0];
-    let mut tmp = vec![0f32; w * h];
-    for y in 0..h {
-        let row = &src[y * w..(y + 1) * w];
-        for x in 0..w {
-            let mut v = 0.0;
-            for (k, c) in K.iter().enumerate() {
-                let xx = (x + k).saturating_sub(2).min(w - 1);
-                v += c * row[xx] as f32;
-            }
-            tmp[y * w + x] = v;
-        }
-    }
-    let mut out = vec![0f32; w * h];
-    for y in 0..h {
-        for (k, c) in K.iter().enumerate() {
-            let yy = (y + k).saturating_sub(2).min(h - 1);
-            let (src_row, dst_row) = (&tmp[yy * w..(yy + 1) * w], &mut out[y * w..(y + 1) * w]);
-            for (d, s) in dst_row.iter_mut().zip(src_row) {
-                *d += c * s;
-            }
-        }
-    }
-    out
-}
-
-/// Sobel gradient magnitude (gray levels per pixel) and orientation (radians, `atan2(gy,
-/// gx)`); the one-pixel border has magnitude 0.
-fn gradients(img: &[f32], w: usize, h: usize) -> (Vec<f32>, Vec<f32>) {
-    let mut mag = vec![0f32; w * h];
-    let mut ang = vec![0f32; w * h];
-    for y in 1..h - 1 {
-        let (up, mid, down) = (
-            &img[(y - 1) * w..y * w],
-            &img[y * w..(y + 1) * w],
-            &img[(y + 1) * w..(y + 2) * w],
-        );
-        for x in 1..w - 1 {
-            let gx = ((up[x + 1] + 2.0 * mid[x + 1] + down[x + 1])
-                - (up[x - 1] + 2.0 * mid[x - 1] + down[x - 1]))
-                / 8.0;
-            let gy = ((down[x - 1] + 2.0 * down[x] + down[x + 1])
-                - (up[x - 1] + 2.0 * up[x] + up[x + 1]))
-                / 8.0;
-            mag[y * w + x] = gx.hypot(gy);
-            ang[y * w + x] = gy.atan2(gx);
-        }
-    }
-    (mag, ang)
 }
 
 #[cfg(test)]

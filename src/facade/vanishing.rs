@@ -23,9 +23,9 @@ use std::f64::consts::PI;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
 use super::error::FacadeError;
-use super::gray::Gray;
 use super::homography::{warp_gray, Homography};
 use super::segments::{detect, Segment};
+use crate::geometry::image::Gray;
 
 /// Largest deviation from vertical of a near-vertical segment.
 pub const VERTICAL_TOLERANCE_DEG: f64 = 30.0;

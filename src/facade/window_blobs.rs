@@ -1,14 +1,15 @@
 //! Windows found as dark blobs of the rectified facade: a pixel belongs to a window candidate
 //! when it is darker than its neighbourhood (glass shows the unlit inside), candidates are the
-//! connected pieces of such pixels whose bounding box has a window's size, shape and fill,
-//! and a candidate is kept only when another one of about its size stands in its row or its
+//! four-connected pieces of such pixels whose bounding box has a window's size, shape and
+//! fill, and a candidate is kept only when another one of about its size stands in its row or its
 //! column (windows repeat: Müller et al.'s prior, without asking for one global lattice, which
 //! street photos of several buildings break), when its outline is a sharp step (a frame) and
 //! when it stands above the ground floor. The parameters were chosen on the tuning half of
 //! the labelled photos (`scripts/facades_eval.rhai --set half=tune`).
 
-use super::gray::Gray;
 use super::rect::Rect;
+use crate::geometry::image::filters::integral_images;
+use crate::geometry::image::{components, Connectivity, Gray};
 
 /// Parameters of the detector (fractions are of the facade region).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -59,20 +60,6 @@ impl Default for BlobParams {
     }
 }
 
-/// Sums of `v` over `[0, x) × [0, y)`, `(w + 1) × (h + 1)`, row-major.
-fn integral(v: impl Iterator<Item = f64>, w: usize, h: usize) -> Vec<f64> {
-    let mut s = vec![0.0; (w + 1) * (h + 1)];
-    let mut v = v;
-    for y in 0..h {
-        let mut row = 0.0;
-        for x in 0..w {
-            row += v.next().unwrap_or(0.0);
-            s[(y + 1) * (w + 1) + x + 1] = s[y * (w + 1) + x + 1] + row;
-        }
-    }
-    s
-}
-
 /// The pixels darker than their neighbourhood's mean by `contrast` standard deviations (at
 /// least one grey level), inside `region` only; row-major over the whole image.
 pub fn dark_pixels(img: &Gray, region: &Rect, p: &BlobParams) -> Vec<bool> {
@@ -80,16 +67,15 @@ pub fn dark_pixels(img: &Gray, region: &Rect, p: &BlobParams) -> Vec<bool> {
     let side = (region.x1 - region.x0).max(region.y1 - region.y0) as f64;
     let r = ((p.scale * side) as usize).max(3);
     let g = |i: usize| img.data[i] as f64;
-    let s1 = integral((0..w * h).map(g), w, h);
-    let s2 = integral((0..w * h).map(|i| g(i) * g(i)), w, h);
+    let (s1, s2) = integral_images(img);
     let mut dark = vec![false; w * h];
     for y in region.y0 as usize..region.y1 as usize {
         let (ya, yb) = (y.saturating_sub(r), (y + r + 1).min(h));
         for x in region.x0 as usize..region.x1 as usize {
             let (xa, xb) = (x.saturating_sub(r), (x + r + 1).min(w));
-            let sum = |s: &[f64]| {
-                s[yb * (w + 1) + xb] - s[ya * (w + 1) + xb] - s[yb * (w + 1) + xa]
-                    + s[ya * (w + 1) + xa]
+            let sum = |s: &[u64]| {
+                let at = |y: usize, x: usize| s[y * (w + 1) + x] as f64;
+                at(yb, xb) - at(ya, xb) - at(yb, xa) + at(ya, xa)
             };
             let n = ((yb - ya) * (xb - xa)) as f64;
             let mean = sum(&s1) / n;
@@ -98,57 +84,6 @@ pub fn dark_pixels(img: &Gray, region: &Rect, p: &BlobParams) -> Vec<bool> {
         }
     }
     dark
-}
-
-/// Connected pieces (4-neighbours) of the set pixels: bounding box and pixel count of each,
-/// in the order of their first pixel (row-major).
-pub fn pieces(mask: &[bool], w: usize, h: usize) -> Vec<(Rect, u64)> {
-    let mut seen = vec![false; mask.len()];
-    let mut stack = Vec::new();
-    let mut out = Vec::new();
-    for start in 0..mask.len() {
-        if !mask[start] || seen[start] {
-            continue;
-        }
-        seen[start] = true;
-        stack.push(start);
-        let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
-        let mut n = 0u64;
-        while let Some(i) = stack.pop() {
-            let (x, y) = (i % w, i / w);
-            n += 1;
-            x0 = x0.min(x);
-            y0 = y0.min(y);
-            x1 = x1.max(x + 1);
-            y1 = y1.max(y + 1);
-            let mut visit = |j: usize| {
-                if mask[j] && !seen[j] {
-                    seen[j] = true;
-                    stack.push(j);
-                }
-            };
-            if x > 0 {
-                visit(i - 1);
-            }
-            if x + 1 < w {
-                visit(i + 1);
-            }
-            if y > 0 {
-                visit(i - w);
-            }
-            if y + 1 < h {
-                visit(i + w);
-            }
-        }
-        let r = Rect {
-            x0: x0 as u32,
-            y0: y0 as u32,
-            x1: x1 as u32,
-            y1: y1 as u32,
-        };
-        out.push((r, n));
-    }
-    out
 }
 
 /// Mean absolute grey step across the outline of `r`: between each pixel of its first and
@@ -195,8 +130,13 @@ pub fn detect_windows(img: &Gray, region: &Rect, p: &BlobParams) -> Vec<Rect> {
     let area = region.area() as f64;
     // rows below this are ground floor
     let ground = region.y1 - ((region.y1 - region.y0) as f64 * p.ground).round() as u32;
-    let candidates: Vec<Rect> = pieces(&dark, img.width as usize, img.height as usize)
+    let (w, h) = (img.width as usize, img.height as usize);
+    let candidates: Vec<Rect> = components(&dark, w, h, Connectivity::Four)
         .into_iter()
+        .map(|c| {
+            let [x0, y0, x1, y1] = c.bbox;
+            (Rect { x0, y0, x1, y1 }, c.pixels)
+        })
         .filter(|(r, n)| {
             let a = r.area() as f64;
             let aspect = (r.y1 - r.y0) as f64 / (r.x1 - r.x0) as f64;
@@ -362,16 +302,6 @@ mod tests {
         // without the outline test they would pass
         let lax = BlobParams { border: 0.0, ..p };
         assert_eq!(detect_windows(&img, &Rect::new(0, 0, w, h), &lax).len(), 3);
-    }
-
-    #[test]
-    fn pieces_are_four_connected() {
-        // two pixels touching at a corner are two pieces
-        let mask = [true, false, false, true];
-        let p = pieces(&mask, 2, 2);
-        assert_eq!(p.len(), 2);
-        assert_eq!(p[0], (Rect::new(0, 0, 1, 1), 1));
-        assert_eq!(p[1], (Rect::new(1, 1, 2, 2), 1));
     }
 
     #[test]

@@ -12,8 +12,8 @@ use std::collections::BTreeMap;
 use super::grammar::{Body, Dir, Grammar, Size};
 use super::labels::Class;
 use super::rect::Rect;
+use super::refinement::{framed_window, named, Refinement};
 use super::structure::root;
-use super::tile_refinement::{framed_window, named, Refinement};
 
 /// The extent of `r` along `dir`.
 fn span(r: &Rect, dir: Dir) -> (u32, u32) {
@@ -294,7 +294,7 @@ fn units_of(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::facade::parse::{rasterize, round_trip};
+    use crate::facade::rasterize::{rasterize, round_trip};
 
     #[test]
     fn the_rules_paint_the_windows_back_exactly() {

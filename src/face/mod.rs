@@ -13,10 +13,10 @@
 //!   adaptation of the generic mesh to a person's photos, and its outputs;
 //! - [`texture_bake`], [`export`], [`error_map`]: texture from photos, OBJ+MTL and glTF files,
 //!   the signed error map between two surfaces;
-//! - [`head_pose`], [`skin`], [`sequence`], [`sequence_files`]: synthetic sequences with ground
-//!   truth (pose and FAP trajectories) and reading sequence folders;
-//! - [`gray`], [`samples`], [`tracker`], [`track_run`]: tracking of head pose and expression,
-//!   and its outputs.
+//! - [`head_pose`], [`skin`], [`sequence`], [`sequence_options`], [`sequence_files`]: synthetic
+//!   sequences with ground truth (pose and FAP trajectories) and reading sequence folders;
+//! - [`samples`], [`tracker`], [`track_run`]: tracking of head pose and expression (on the grey
+//!   images of [`crate::geometry::image`]), and its outputs.
 
 pub mod adapt;
 pub mod align;
@@ -29,7 +29,6 @@ pub mod export;
 pub mod expressions;
 pub mod fap;
 pub mod fit_run;
-pub mod gray;
 pub mod head_pose;
 pub mod landmarks;
 pub mod model;
@@ -41,6 +40,7 @@ pub mod render;
 pub mod samples;
 pub mod sequence;
 pub mod sequence_files;
+pub mod sequence_options;
 pub mod skin;
 pub mod texture_bake;
 pub mod track_run;

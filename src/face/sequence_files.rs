@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use super::head_pose::HeadPose;
 use super::model::FaceMesh;
-use super::sequence::FaceSequenceOptions;
+use super::sequence_options::FaceSequenceOptions;
 use super::FaceError;
 use crate::geometry::Camera;
 use crate::geometry::Vec3;

@@ -26,11 +26,11 @@ use std::cell::RefCell;
 use nalgebra::{Matrix6, Vector6};
 
 use super::fap::FapRig;
-use super::gray::GrayImage;
 use super::head_pose::{head_pivot, HeadPose};
 use super::model::FaceMesh;
 use super::samples::SurfaceSamples;
 use super::FaceError;
+use crate::geometry::image::GradientImage;
 use crate::geometry::least_squares::{Attempt, Damping, DampingUpdate, DiagonalDamping, Tries};
 use crate::geometry::Camera;
 use crate::geometry::{SplitMix64, Vec3};
@@ -129,7 +129,7 @@ impl FaceTrackerOptions {
 /// One camera's images and per-frame state.
 struct View {
     cam: [Camera; 2],
-    img: [GrayImage; 2],
+    img: [GradientImage; 2],
     gain: f64,
     /// Visibility weight of each sample (0: not seen).
     vis: Vec<f32>,
@@ -206,7 +206,6 @@ pub struct FaceTracker {
     posed: Vec<Vec3>,
     sample_pos: Vec<Vec3>,
     sample_nrm: Vec<Vec3>,
-    blur_scratch: Vec<f32>,
     anneal_scratch: AnnealScratch,
     frame: usize,
     /// Seconds spent per stage over all frames: images, visibility, rigid, expression.
@@ -350,7 +349,7 @@ impl FaceTracker {
             .iter()
             .map(|c| View {
                 cam: [c.clone(), c.scaled(2.0)],
-                img: [GrayImage::default(), GrayImage::default()],
+                img: [GradientImage::default(), GradientImage::default()],
                 gain: 1.0,
                 vis: Vec::new(),
             })
@@ -377,7 +376,6 @@ impl FaceTracker {
             posed: Vec::new(),
             sample_pos: Vec::new(),
             sample_nrm: Vec::new(),
-            blur_scratch: Vec::new(),
             anneal_scratch: AnnealScratch::default(),
             frame: 0,
             stage_seconds: [0.0; 4],
@@ -416,8 +414,8 @@ impl FaceTracker {
                 ));
             }
             let [fine, coarse] = &mut v.img;
-            fine.set_from_rgb(img, 0.8, &mut self.blur_scratch);
-            coarse.set_half_of(fine, 1.0, &mut self.blur_scratch);
+            fine.set_from_rgb(img, 0.8);
+            coarse.set_half_of(fine, 1.0);
         }
         Ok(())
     }

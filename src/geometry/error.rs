@@ -1,8 +1,9 @@
-//! Errors of the geometry module: files that cannot be read or parsed, meshes that are invalid.
+//! Errors of the geometry module: files that cannot be read or parsed (meshes, images), meshes
+//! that are invalid.
 
 use std::path::PathBuf;
 
-/// What can go wrong while building, reading or writing a mesh.
+/// What can go wrong while building, reading or writing a mesh or reading an image.
 #[derive(Debug, thiserror::Error)]
 pub enum GeometryError {
     /// The file could not be opened, read or written.
@@ -21,6 +22,14 @@ pub enum GeometryError {
         /// 1-based line number (0 when unknown).
         line: usize,
         /// What is wrong.
+        message: String,
+    },
+    /// An image file could not be opened or decoded.
+    #[error("{path}: {message}")]
+    Image {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
         message: String,
     },
     /// A mesh or a parameter is invalid.

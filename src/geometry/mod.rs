@@ -1,6 +1,7 @@
 //! Geometry: triangle meshes with rest (pattern) coordinates, grid generators, edge/hinge
 //! adjacency, mesh file I/O (OBJ read/write, binary glTF write), the pinhole camera
-//! ([`camera`]), and the Levenberg–Marquardt solver ([`least_squares`]).
+//! ([`camera`]), the Levenberg–Marquardt solver ([`least_squares`]), grey images and their
+//! filters ([`image`]) and seeded random numbers ([`random`]).
 
 pub mod camera;
 pub mod cone;
@@ -8,6 +9,7 @@ pub mod error;
 pub mod files;
 pub mod gltf;
 pub mod grid;
+pub mod image;
 pub mod least_squares;
 pub mod mesh;
 pub mod obj;
@@ -21,7 +23,7 @@ pub use gltf::write_glb;
 pub use grid::grid_mesh;
 pub use mesh::TriMesh;
 pub use obj::{read_obj, read_obj_surface, write_obj};
-pub use random::SplitMix64;
+pub use random::{Lcg64, SplitMix64};
 pub use topology::{Edge, Hinge, Topology};
 
 /// Three-vector of f64, SI units (metres, m/s, newtons).

@@ -15,7 +15,7 @@ use crate::facade::facade_mesh::MeshParams;
 use crate::facade::grammar::{Body, Grammar};
 use crate::facade::homography::warp_labels;
 use crate::facade::outputs::{write_generated, write_outputs, OutputOptions};
-use crate::facade::parse::{rasterize, round_trip};
+use crate::facade::rasterize::{rasterize, round_trip};
 use crate::facade::{Class, FacadeParse};
 
 /// An analysed photo as a script handle (shared, never copied).

@@ -18,8 +18,9 @@ use crate::face::fit_run::{fit_folder, load_photos, write_fit_outputs, PhotoSet}
 use crate::face::model::FaceMesh;
 use crate::face::muscles::MuscleRig;
 use crate::face::preview::expression_image;
-use crate::face::sequence::{make_face_sequence, FaceSequenceOptions};
+use crate::face::sequence::make_face_sequence;
 use crate::face::sequence_files::FaceSequence;
+use crate::face::sequence_options::FaceSequenceOptions;
 use crate::face::track_run::{track_face_sequence, write_face_track_outputs};
 use crate::face::tracker::FaceTrackerOptions;
 

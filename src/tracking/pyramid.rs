@@ -5,6 +5,9 @@
 
 use image::RgbImage;
 
+use crate::geometry::image::filters::half_size;
+use crate::geometry::image::luma;
+
 /// One pyramid level: `width × height` RGB pixels, row-major, values in 0..255.
 #[derive(Clone, Debug, Default)]
 pub struct Level {
@@ -37,21 +40,7 @@ impl Level {
 
     /// The next coarser level: 2×2 box means (a trailing odd row or column is dropped).
     pub fn half_into(&self, out: &mut Level) {
-        let (w, h) = (self.width / 2, self.height / 2);
-        out.width = w;
-        out.height = h;
-        out.rgb.clear();
-        out.rgb.reserve(w * h);
-        for y in 0..h {
-            let r0 = 2 * y * self.width;
-            let r1 = r0 + self.width;
-            for x in 0..w {
-                let (a, b) = (self.rgb[r0 + 2 * x], self.rgb[r0 + 2 * x + 1]);
-                let (c, d) = (self.rgb[r1 + 2 * x], self.rgb[r1 + 2 * x + 1]);
-                out.rgb
-                    .push(std::array::from_fn(|k| 0.25 * (a[k] + b[k] + c[k] + d[k])));
-            }
-        }
+        (out.width, out.height) = half_size(&self.rgb, self.width, self.height, &mut out.rgb);
     }
 
     /// Bilinear colour at pixel coordinates `(x, y)`, in the cameras' and the rasteriser's
@@ -128,10 +117,6 @@ pub fn median_background(frames: &[&RgbImage]) -> Level {
     }
 }
 
-fn luminance(p: &[f32; 3]) -> f32 {
-    0.299 * p[0] + 0.587 * p[1] + 0.114 * p[2]
-}
-
 /// Global lighting gain of `image` against `background` (same size): the median ratio of
 /// their luminances over pixels bright enough to measure it. The person covers a small part
 /// of the picture, so the median ignores it. 1 when nothing can be measured.
@@ -144,9 +129,9 @@ pub fn lighting_gain(image: &Level, background: &Level, scratch: &mut Vec<f32>) 
     for y in (0..image.height).step_by(2) {
         for x in (0..image.width).step_by(2) {
             let i = y * image.width + x;
-            let b = luminance(&background.rgb[i]);
+            let b = luma(background.rgb[i]);
             if b > 20.0 {
-                scratch.push(luminance(&image.rgb[i]) / b);
+                scratch.push(luma(image.rgb[i]) / b);
             }
         }
     }

@@ -31,7 +31,7 @@ use serde_json::Value;
 use super::joints::{joint_index, JOINT_COUNT, TRACKING_JOINTS};
 use crate::body::BodyError;
 use crate::geometry::camera::{Camera, CameraError};
-use crate::geometry::{SplitMix64, Vec3};
+use crate::geometry::{GeometryError, SplitMix64, Vec3};
 
 /// Joint positions of one frame, in [`TRACKING_JOINTS`] order.
 pub type JointFrame = [Vec3; JOINT_COUNT];
@@ -515,14 +515,16 @@ pub(crate) fn list_photos(dir: &Path) -> Result<Vec<PathBuf>, SequenceError> {
     Ok(photos)
 }
 
-/// An image file as 8-bit RGB; the error names the file.
+/// An image file as 8-bit RGB ([`geometry::image::read_rgb`](crate::geometry::image::read_rgb));
+/// the error names the file.
 fn read_rgb(path: &Path) -> Result<RgbImage, SequenceError> {
-    Ok(image::open(path)
-        .map_err(|e| SequenceError::Image {
+    crate::geometry::image::read_rgb(path).map_err(|e| match e {
+        GeometryError::Image { path, message } => SequenceError::Image { path, message },
+        other => SequenceError::Image {
             path: path.to_path_buf(),
-            message: e.to_string(),
-        })?
-        .into_rgb8())
+            message: other.to_string(),
+        },
+    })
 }
 
 /// `photo` scaled to cover `w × h` and cropped at a seeded place.

@@ -3,8 +3,9 @@
 //! tree in front of the lower left).
 #![allow(dead_code)]
 
-use emilion::facade::gray::Gray;
 use emilion::facade::{Class, LabelMap, Rect};
+use emilion::geometry::image::Gray;
+use emilion::geometry::Lcg64;
 
 pub const FLOOR: u32 = 57;
 pub const TILE: u32 = 43;
@@ -26,13 +27,8 @@ pub fn facade_with_bars(
     scale: u32,
     bar: &dyn Fn(u32, u32) -> bool,
 ) -> Gray {
-    let mut s = seed;
-    let mut rnd = || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (s >> 40) as f64 / (1u64 << 24) as f64
-    };
+    let mut rng = Lcg64::new(seed);
+    let mut rnd = || (rng.next_u64() >> 40) as f64 / (1u64 << 24) as f64;
     let mut data = Vec::with_capacity((width * height) as usize);
     for y in 0..height {
         for x in 0..width {
@@ -94,17 +90,12 @@ pub fn window_truth(width: u32, height: u32) -> LabelMap {
 
 /// Uniform 8-bit noise (a picture with no structure), seeded.
 pub fn noise(width: u32, height: u32, seed: u64) -> Gray {
-    let mut s = seed;
+    let mut rng = Lcg64::new(seed);
     Gray {
         width,
         height,
         data: (0..width * height)
-            .map(|_| {
-                s = s
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                (s >> 56) as u8
-            })
+            .map(|_| (rng.next_u64() >> 56) as u8)
             .collect(),
     }
 }
