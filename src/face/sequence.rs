@@ -33,7 +33,6 @@ use super::sequence_files::{write_pose_csv, PoseRow, SequenceInfo};
 use super::sequence_options::FaceSequenceOptions;
 use super::skin::procedural_face_texture;
 use super::FaceError;
-use crate::geometry::files::data_dir;
 use crate::geometry::Camera;
 use crate::geometry::{write_obj, SplitMix64, Vec3};
 

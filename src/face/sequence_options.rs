@@ -4,8 +4,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::model::data_dir;
 use super::FaceError;
+use crate::geometry::files::data_dir;
 
 /// Settings of [`make_face_sequence`](super::sequence::make_face_sequence).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
