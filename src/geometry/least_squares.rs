@@ -439,7 +439,7 @@ mod tests {
         // a matrix no damping makes positive definite raises λ by the singular factor
         let neg = nalgebra::Matrix2::new(-1.0, 0.0, 0.0, -1.0);
         assert!(d.solve(&neg, &g).is_none());
-        assert_eq!(d.lambda, 640.0 / 3.0);
+        assert_eq!(d.lambda, 64.0 / 3.0 * 10.0);
         let mut n = Damping::new(
             1.0,
             DiagonalDamping::Shifted { floor: 0.0 },

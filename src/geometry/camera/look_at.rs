@@ -6,9 +6,8 @@
 //! ([`LookAtCamera::project`]: `R (p − eye)` and pixel corners at integers), the arithmetic its
 //! pictures have always had.
 
-use serde::{Deserialize, Serialize};
-
 use nalgebra::Matrix3;
+use serde::{Deserialize, Serialize};
 
 use super::Camera;
 use crate::geometry::Vec3;
@@ -18,8 +17,9 @@ pub const NEAR: f64 = 1e-3;
 /// Largest image width or height (pixels) the renderer produces; larger sizes are clamped.
 pub const MAX_SIZE: u32 = 16384;
 
-/// A pinhole perspective camera looking from `eye` at `target`, with `up` giving the image's
-/// upward direction (Z is up in the scene). Pixel (0, 0) is the top-left corner of the image;
+/// The placement of a pinhole perspective camera looking from `eye` at `target`, with `up`
+/// giving the image's upward direction (Z is up in the scene); [`to_camera`](Self::to_camera)
+/// gives the [`Camera`]. Pixel (0, 0) is the top-left corner of the image;
 /// pixel centres are at half-integer coordinates.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
