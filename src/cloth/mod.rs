@@ -1,6 +1,6 @@
 //! Cloth: particle state, force elements and material laws, the block-sparse implicit solver
-//! (Baraff & Witkin) and the explicit one, constraints (pins, attachments, contact hook),
-//! per-step statistics.
+//! (Baraff & Witkin) and the explicit one, constraints (pins, attachments, the filter), the
+//! step stages through which contact takes part in a step, per-step statistics.
 
 pub mod aggregation;
 pub mod amg;
@@ -22,16 +22,18 @@ pub mod parallel;
 pub mod pcg;
 pub mod sewing;
 pub mod simulation;
+pub mod stage;
 pub mod state;
 pub mod stats;
 pub mod wrinkles;
 
-pub use constraints::{Attachment, ContactHook, Filter, Floor, Obstacles, Trajectory};
+pub use constraints::{Attachment, Filter, Trajectory};
 pub use error::ClothError;
 pub use material::{Direction, FabricParameters, Friction, LinearMaterial, MaterialLaw};
 pub use measured::{MeasuredLaw, ResponseCurve};
 pub use model::ClothModel;
 pub use sewing::{Separation, Sewing};
 pub use simulation::{Integrator, PreconditionerKind, Simulation, SimulationParameters};
+pub use stage::{Obstacles, StepEnd, StepStage};
 pub use state::ClothState;
 pub use stats::StepStats;

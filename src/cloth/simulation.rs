@@ -1,4 +1,4 @@
-//! `Simulation`: a cloth model, its state, constraints and contact hooks, stepped by the
+//! `Simulation`: a cloth model, its state, constraints and step stages, stepped by the
 //! implicit (Baraff–Witkin) or the explicit (symplectic Euler) integrator. Every step checks
 //! for divergence and leaves the state untouched when it fails.
 
@@ -9,15 +9,15 @@ use serde::{Deserialize, Serialize};
 use super::amg::AggregationMultigrid;
 use super::assembly::{Assembly, AssemblyInputs};
 use super::buckling_side::BucklingSides;
-use super::constraints::{Attachment, ContactHook, Filter, Obstacles, ParticleFilter, Trajectory};
+use super::constraints::{Attachment, Filter, ParticleFilter, Trajectory};
 use super::model::ClothModel;
 use super::multigrid::Multigrid;
 use super::pcg::{PcgResult, PcgWorkspace, Preconditioner};
 use super::sewing::Sewing;
+use super::stage::{Obstacles, StepEnd, StepStage};
 use super::state::ClothState;
 use super::stats::StepStats;
 use super::ClothError;
-use crate::contact::Collisions;
 use crate::geometry::Vec3;
 
 /// Time integrator.
@@ -127,16 +127,14 @@ pub struct Simulation {
     pub params: SimulationParameters,
     /// Pins and moving attachments.
     pub attachments: Vec<Attachment>,
-    /// Contact handlers consulted every step.
-    pub hooks: Vec<Box<dyn ContactHook>>,
-    /// Collision bodies, self-collision and their settings.
-    pub contact: Collisions,
     /// Statistics of every step taken.
     pub stats: Vec<StepStats>,
     /// The sewing schedule of a garment's seams, if any.
     pub sewing: Option<Sewing>,
     /// Steps whose CG solve did not reach the tolerance.
     pub unconverged_steps: u64,
+    /// Stages of every step beside the cloth's forces (contact), in the order added.
+    stages: Vec<Box<dyn StepStage>>,
     filter: Filter,
     z: Vec<Vec3>,
     dv: Vec<Vec3>,
@@ -177,19 +175,16 @@ impl Simulation {
             // the multigrid enabled the single-precision mirrors its smoother reads
             asm.jacobi = false;
         }
-        let mut contact = Collisions::default();
-        contact.set_cloth(&model.mesh.triangles, &model.mesh.positions);
         let sides = (model.choi_ko && !model.flexion_sides.is_empty())
             .then(|| BucklingSides::new(model.flexion_sides.clone(), model.choi_ko_seed));
         Ok(Simulation {
             sides,
-            contact,
             impulse: vec![Vec3::zeros(); n],
             x_step: vec![Vec3::zeros(); n],
             state,
             params,
             attachments: Vec::new(),
-            hooks: Vec::new(),
+            stages: Vec::new(),
             stats: Vec::new(),
             sewing: None,
             unconverged_steps: 0,
@@ -294,9 +289,32 @@ impl Simulation {
         out
     }
 
-    /// Adds a contact handler.
-    pub fn add_hook(&mut self, hook: Box<dyn ContactHook>) {
-        self.hooks.push(hook);
+    /// Adds a stage to every step: stages constrain particles in the order added and respond
+    /// in reverse order (add contact with bodies first).
+    pub fn add_stage(&mut self, stage: Box<dyn StepStage>) {
+        self.stages.push(stage);
+    }
+
+    /// The step's stages, in the order added.
+    pub fn stages(&self) -> &[Box<dyn StepStage>] {
+        &self.stages
+    }
+
+    /// The first stage of type `T`, if any.
+    pub fn stage<T: StepStage>(&self) -> Option<&T> {
+        self.stages.iter().find_map(|s| s.as_any().downcast_ref())
+    }
+
+    /// The first stage of type `T`, mutable, if any.
+    pub fn stage_mut<T: StepStage>(&mut self) -> Option<&mut T> {
+        self.stages
+            .iter_mut()
+            .find_map(|s| s.as_any_mut().downcast_mut())
+    }
+
+    /// Whether some stage reads the step's start positions and constraint impulses.
+    fn stages_use_impulses(&self) -> bool {
+        self.stages.iter().any(|s| s.uses_impulses())
     }
 
     /// Energies of the current state: (kinetic, gravitational, elastic). Reading them leaves
@@ -331,7 +349,7 @@ impl Simulation {
 
     fn build_filter(&mut self, t_end: f64, dt: f64) {
         self.filter.clear();
-        // attachments first: the contact stage and the hooks leave fixed particles alone, so
+        // attachments first: the stages leave fixed particles alone, so
         // friction never holds back (or moves) a particle that follows its target
         for at in &self.attachments {
             let d = at.trajectory.displacement(t_end);
@@ -342,27 +360,16 @@ impl Simulation {
                 self.filter.any = true;
             }
         }
-        if self.contact.is_active() {
-            self.contact.begin_step(
+        // each stage sees the obstacles of the stages before it
+        for k in 0..self.stages.len() {
+            let (before, rest) = self.stages.split_at_mut(k);
+            rest[0].constrain(
                 &self.state.x,
                 &self.state.v,
                 t_end - dt,
                 dt,
                 &mut self.filter,
-            );
-        }
-        let obstacles = Obstacles {
-            bodies: &self.contact.bodies,
-            clearance: self.contact.settings.thickness,
-        };
-        for hook in &mut self.hooks {
-            hook.constrain(
-                &self.state.x,
-                &self.state.v,
-                self.state.time,
-                dt,
-                &mut self.filter,
-                obstacles,
+                Obstacles::of(before),
             );
         }
     }
@@ -378,22 +385,13 @@ impl Simulation {
         let t_start = Instant::now();
         if let Some(sew) = &mut self.sewing {
             self.params.gravity = sew.update(&mut self.model, self.state.time, &self.state.x);
-            self.contact.frictionless = sew.sewing_at(self.state.time);
-            if !sew.pass_through.is_empty() {
-                let zones: &[u32] = if sew.sewing_at(self.state.time) {
-                    &sew.pass_through
-                } else {
-                    &[]
-                };
-                self.contact.set_zones(zones);
+            for stage in &mut self.stages {
+                stage.follow_sewing(sew, self.state.time);
             }
         }
         if let Some(sides) = &mut self.sides {
             let attachments = &self.attachments;
-            let obstacles = Obstacles {
-                bodies: &self.contact.bodies,
-                clearance: self.contact.settings.thickness,
-            };
+            let obstacles = Obstacles::of(&self.stages);
             sides.start_arcs(
                 &mut self.state.x,
                 |i| attachments.iter().any(|a| a.particles.contains(&i)),
@@ -420,7 +418,10 @@ impl Simulation {
             sew.slow_down(self.state.time, &mut self.state.v);
             if let Some(sep) = sew.separation.as_ref() {
                 if sew.sewing_at(self.state.time) {
-                    let crossings = self.contact.self_intersections(&self.state.x);
+                    let mut crossings = Vec::new();
+                    for stage in &mut self.stages {
+                        crossings.extend(stage.crossings(&self.state.x));
+                    }
                     sep.apply(&crossings, &mut self.state.x);
                 }
             }
@@ -472,8 +473,8 @@ impl Simulation {
         let elastic = self
             .asm
             .assemble(&self.model, &self.state.x, &self.state.v, inp);
-        if self.contact.is_active() {
-            self.contact.add_kinetic_friction(&mut self.asm.b);
+        for stage in &mut self.stages {
+            stage.add_forces(&mut self.asm.b);
         }
         let t1 = Instant::now();
         for i in 0..self.particle_count() {
@@ -524,7 +525,7 @@ impl Simulation {
             };
         }
         let t2 = Instant::now();
-        if self.contact.is_active() {
+        if self.stages_use_impulses() {
             self.x_step.copy_from_slice(&self.state.x);
             // constraint impulses: the residual A Δv − b lies in the constrained directions
             for i in 0..self.particle_count() {
@@ -564,43 +565,34 @@ impl Simulation {
         }
     }
 
-    /// Snaps fixed particles exactly onto their targets, lets hooks correct positions, then
-    /// runs the contact stage's response (friction, push-out, self-collision) on the step of
-    /// length `h` that started at `x_step`.
+    /// Snaps fixed particles exactly onto their targets, then runs the stages' responses
+    /// (friction, push-out, self-collision), last added first, on the step of length `h` that
+    /// started at `x_step`.
     fn finish_constraints(&mut self, h: f64) {
         for i in 0..self.particle_count() {
             if let ParticleFilter::Fixed { target } = self.filter.kind[i] {
                 self.state.x[i] = target;
             }
         }
-        for hook in &mut self.hooks {
-            hook.correct(&mut self.state.x, &mut self.state.v);
-        }
-        if self.contact.is_active() {
-            self.contact.end_step(
-                &self.x_step,
-                &mut self.state.x,
-                &mut self.state.v,
-                &self.impulse,
-                &self.model.mass,
-                &self.filter,
-                h,
-            );
+        for stage in self.stages.iter_mut().rev() {
+            stage.respond(StepEnd {
+                x_start: &self.x_step,
+                x: &mut self.state.x,
+                v: &mut self.state.v,
+                impulse: &self.impulse,
+                mass: &self.model.mass,
+                filter: &self.filter,
+                dt: h,
+            });
         }
     }
 
-    /// Copies the contact stage's statistics of the last step into `st`.
+    /// Copies the stages' statistics of the last step into `st` (no body near: an infinite
+    /// distance).
     fn contact_stats(&self, st: &mut StepStats) {
-        if self.contact.is_active() {
-            let c = &self.contact.stats;
-            st.collision_ms = c.collision_ms;
-            st.contacts = c.contacts;
-            st.self_contacts = c.self_contacts;
-            st.min_distance = c.min_distance;
-            st.penetrating = c.penetrating;
-            st.intersections = c.intersections;
-        } else {
-            st.min_distance = f64::INFINITY;
+        st.min_distance = f64::INFINITY;
+        for stage in &self.stages {
+            stage.report(st);
         }
     }
 
@@ -625,7 +617,7 @@ impl Simulation {
             if k == 0 {
                 elastic0 = e;
             }
-            if self.contact.is_active() {
+            if self.stages_use_impulses() {
                 self.x_step.copy_from_slice(&self.state.x);
             }
             for i in 0..self.particle_count() {

@@ -10,7 +10,8 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::body::{Body, FrictionCoefficients, Proximity, Shape};
+use super::body::{Body, FrictionCoefficients, Shape};
+use super::proximity::Proximity;
 use super::mesh_body::MeshBody;
 use super::primitives::closest_point_triangle;
 use super::self_collision::{SelfCollision, SelfCollisionReport};
@@ -203,9 +204,13 @@ impl Collisions {
         !self.bodies.is_empty() || self.settings.self_collision
     }
 
-    /// Prepares self-collision for a cloth with these triangles and rest positions.
-    pub fn set_cloth(&mut self, triangles: &[[usize; 3]], rest: &[Vec3]) {
-        self.self_collision = Some(SelfCollision::new(triangles, rest));
+    /// The contact of a cloth with these triangles and rest positions: no bodies, default
+    /// settings, self-collision ready to be switched on.
+    pub fn for_cloth(triangles: &[[usize; 3]], rest: &[Vec3]) -> Self {
+        Collisions {
+            self_collision: Some(SelfCollision::new(triangles, rest)),
+            ..Default::default()
+        }
     }
 
     /// Sets self-collision's pass-through zones (see [`SelfCollision::set_zones`]).
