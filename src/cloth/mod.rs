@@ -11,6 +11,7 @@ pub mod buckling_side;
 pub mod choi_ko;
 pub mod compression_release;
 pub mod constraints;
+pub(crate) mod contribution;
 pub mod elements;
 pub mod error;
 pub mod line_solver;
