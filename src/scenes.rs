@@ -7,9 +7,7 @@ use std::path::{Path, PathBuf};
 use indicatif::ProgressBar;
 
 use crate::cloth::stats::write_csv;
-use crate::cloth::{
-    ClothError, ClothModel, FabricParameters, Simulation, SimulationParameters,
-};
+use crate::cloth::{ClothError, ClothModel, FabricParameters, Simulation, SimulationParameters};
 use crate::contact::{Body, Floor, SimulationContact};
 use crate::geometry::mesh::bounds;
 use crate::geometry::Vec3;

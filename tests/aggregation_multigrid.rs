@@ -31,7 +31,8 @@ fn drop_on_ball(n: usize, params: SimulationParameters) -> Simulation {
         *p += Vec3::new(-0.3, -0.3, 0.22);
     }
     let mut sim = Simulation::new(model, params).unwrap();
-    sim.add_contact().bodies
+    sim.add_contact()
+        .bodies
         .push(Body::sphere(Vec3::zeros(), 0.2).unwrap());
     sim
 }

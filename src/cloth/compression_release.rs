@@ -26,9 +26,9 @@
 //! `hold_steps` before it is released again.
 
 use super::constraints::{Filter, ParticleFilter};
-use super::stage::{Obstacles, StepStage};
 use super::elements::SpringKind;
 use super::model::ClothModel;
+use super::stage::{Obstacles, StepStage};
 use crate::geometry::Vec3;
 
 /// The farthest a release moves a particle to the far intersection, in rest lengths of the

@@ -113,12 +113,8 @@ pub(crate) fn contribute_all<E: Contribution>(
                     index: c * CHUNK + k,
                 };
                 let (t, b) = (E::TERMS * k, E::BLOCKS * k);
-                e += els[k].contribute(
-                    p,
-                    state,
-                    &mut g[t..t + E::TERMS],
-                    &mut bl[b..b + E::BLOCKS],
-                );
+                e +=
+                    els[k].contribute(p, state, &mut g[t..t + E::TERMS], &mut bl[b..b + E::BLOCKS]);
             }
             *ep = e;
         });
@@ -209,8 +205,7 @@ impl Contribution for ShearQuad {
             // force on the diagonal's first node (the second gets the opposite)
             let mut ga = d * (q.area * hs * gk * p.hf) + cdamp * rel * p.hf;
             if p.matrix {
-                let kmat =
-                    axial * dhs.max(0.0) + Mat3::identity() * (q.area * hs * gk).max(0.0);
+                let kmat = axial * dhs.max(0.0) + Mat3::identity() * (q.area * hs * gk).max(0.0);
                 ga += kmat * rel * p.hk;
                 bl[m] = Sym3::from_upper(&(kmat * p.hk + cdamp * p.dt));
             }
@@ -345,13 +340,12 @@ impl Contribution for Hinge {
         let stiff = dms.max(0.0) * el.edge * el.edge / el.area;
         let gv: f64 = (0..4).map(|m| grad[m].dot(&v[el.nodes[m]])).sum();
         for m in 0..4 {
-            g[m] = -grad[m]
-                * (dedtheta * p.hf + stiff_el * gv * p.beta_b * p.hf + stiff * gv * p.hk);
+            g[m] =
+                -grad[m] * (dedtheta * p.hf + stiff_el * gv * p.beta_b * p.hf + stiff * gv * p.hk);
             if p.matrix {
                 for q in 0..4 {
-                    bl[4 * m + q] = grad[m]
-                        * grad[q].transpose()
-                        * (stiff * p.hk + stiff_el * p.dt * p.beta_b);
+                    bl[4 * m + q] =
+                        grad[m] * grad[q].transpose() * (stiff * p.hk + stiff_el * p.dt * p.beta_b);
                 }
             }
         }

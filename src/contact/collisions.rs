@@ -11,9 +11,9 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::body::{Body, FrictionCoefficients, Shape};
-use super::proximity::Proximity;
 use super::mesh_body::MeshBody;
 use super::primitives::closest_point_triangle;
+use super::proximity::Proximity;
 use super::self_collision::{SelfCollision, SelfCollisionReport};
 use super::ContactError;
 use crate::cloth::constraints::{Filter, ParticleFilter};

@@ -20,10 +20,10 @@ pub mod stage;
 pub mod tessellate;
 
 pub use body::{Body, FrictionCoefficients, Shape};
-pub use proximity::Proximity;
 pub use collisions::{Collisions, ContactSettings, ContactStats};
 pub use error::ContactError;
 pub use floor::Floor;
 pub use mesh_body::{BodyAnimation, MeshBody};
+pub use proximity::Proximity;
 pub use self_collision::{SelfCollision, SelfCollisionReport};
 pub use stage::SimulationContact;
