@@ -4,8 +4,8 @@
 
 use std::sync::Arc;
 
-use emilion::cloth::choi_ko::buckling_force;
-use emilion::cloth::compression_release::{CompressionRelease, ReleaseOptions};
+use emilion::cloth::buckling::choi_ko::buckling_force;
+use emilion::cloth::buckling::compression_release::{CompressionRelease, ReleaseOptions};
 use emilion::cloth::constraints::ParticleFilter;
 use emilion::cloth::{ClothModel, FabricParameters, Filter, MaterialLaw, Obstacles, StepStage};
 use emilion::garment::patch::rectangle_mesh;

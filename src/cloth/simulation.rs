@@ -6,14 +6,14 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use super::amg::AggregationMultigrid;
-use super::assembly::{Assembly, AssemblyInputs};
-use super::buckling_side::BucklingSides;
+use super::buckling::buckling_side::BucklingSides;
 use super::constraints::{Attachment, Filter, ParticleFilter, Trajectory};
 use super::model::ClothModel;
-use super::multigrid::Multigrid;
-use super::pcg::{PcgResult, PcgWorkspace, Preconditioner};
 use super::sewing::Sewing;
+use super::solver::amg::AggregationMultigrid;
+use super::solver::assembly::{Assembly, AssemblyInputs};
+use super::solver::multigrid::Multigrid;
+use super::solver::pcg::{PcgResult, PcgWorkspace, Preconditioner};
 use super::stage::{Obstacles, StepEnd, StepStage};
 use super::state::ClothState;
 use super::stats::StepStats;

@@ -275,7 +275,7 @@ most compressed springs' particles are sent to where their springs regain their 
 compression that triggers a release, how long a particle is held, the seed of the random
 up/down choice on a flat cloth (one side of the cloth per step for all its ties).",
         |h: &mut SimHandle, m: Map| -> RResult<()> {
-            use crate::cloth::compression_release::{CompressionRelease, ReleaseOptions};
+            use crate::cloth::buckling::compression_release::{CompressionRelease, ReleaseOptions};
             const KEYS: [&str; 3] = ["strain", "hold_steps", "seed"];
             if let Some(k) = m.keys().find(|k| !KEYS.contains(&k.as_str())) {
                 return Err(rt_err(format!(

@@ -7,11 +7,11 @@
 
 use rayon::prelude::*;
 
-use super::arc_connection::ArcConnection;
 use super::bcsr::Sym3;
-use super::elements::{BendLine, Hinge, ShearQuad, Spring, SpringKind};
-use super::material::{Direction, Friction, MaterialLaw};
 use super::parallel::{chunks, ordered_sum, SyncPtr, CHUNK};
+use crate::cloth::buckling::arc_connection::ArcConnection;
+use crate::cloth::elements::material::{Direction, Friction, MaterialLaw};
+use crate::cloth::elements::{BendLine, Hinge, ShearQuad, Spring, SpringKind};
 use crate::geometry::{Mat3, Vec3};
 
 /// What every element sees during one evaluation: the state, the step's factors and the

@@ -15,9 +15,9 @@ use rayon::prelude::*;
 
 use super::aggregation::{aggregate, Graph};
 use super::bcsr::{Bcsr3, Mat3f};
-use super::constraints::{Filter, ParticleFilter};
-use super::model::ClothModel;
 use super::parallel::{for_each_mut, SyncPtr, PAR_MIN};
+use crate::cloth::constraints::{Filter, ParticleFilter};
+use crate::cloth::model::ClothModel;
 use crate::geometry::{Mat3, Vec3};
 
 /// Coarsening stops at this many particles or fewer (the coarsest level is factorised).

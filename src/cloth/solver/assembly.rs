@@ -12,9 +12,9 @@ use rayon::prelude::*;
 
 use super::bcsr::{Bcsr3, Sym3, Sym3f, SYM_ROW_MAX};
 use super::contribution::{contribute_all, Pass};
-use super::material::Direction;
-use super::model::ClothModel;
 use super::parallel::{chunks, stream_copy, stream_fence, SyncPtr, CHUNK};
+use crate::cloth::elements::material::Direction;
+use crate::cloth::model::ClothModel;
 use crate::geometry::{Mat3, Vec3};
 
 /// One matrix contribution: `values[slot] += scale · block src`, the scale kept apart (see

@@ -25,10 +25,10 @@
 //! the self-collision response stops short of its destination is let go, and waits
 //! `hold_steps` before it is released again.
 
-use super::constraints::{Filter, ParticleFilter};
-use super::elements::SpringKind;
-use super::model::ClothModel;
-use super::stage::{Obstacles, StepStage};
+use crate::cloth::constraints::{Filter, ParticleFilter};
+use crate::cloth::elements::SpringKind;
+use crate::cloth::model::ClothModel;
+use crate::cloth::stage::{Obstacles, StepStage};
 use crate::geometry::Vec3;
 
 /// The farthest a release moves a particle to the far intersection, in rest lengths of the

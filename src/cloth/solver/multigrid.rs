@@ -7,11 +7,11 @@
 
 use super::assembly::{Assembly, AssemblyInputs};
 use super::bcsr::{Bcsr3, Sym3f};
-use super::constraints::{Filter, ParticleFilter};
 use super::line_solver::{weft_order, LineDir, LineSolver};
-use super::model::ClothModel;
 use super::parallel::{for_each_mut, PAR_MIN};
-use super::ClothError;
+use crate::cloth::constraints::{Filter, ParticleFilter};
+use crate::cloth::model::ClothModel;
+use crate::cloth::ClothError;
 use crate::geometry::Vec3;
 
 /// Coarsest grid size (particles per side) at which the V-cycle stops coarsening.
