@@ -12,3 +12,4 @@ pub mod line_solver;
 pub mod multigrid;
 pub mod parallel;
 pub mod pcg;
+pub(crate) mod vcycle;
