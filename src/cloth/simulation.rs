@@ -133,6 +133,8 @@ pub struct Simulation {
     pub sewing: Option<Sewing>,
     /// Steps whose CG solve did not reach the tolerance.
     pub unconverged_steps: u64,
+    /// Share of `params.gravity` acting (a garment's sewing turns it down while it sews).
+    gravity_share: f64,
     /// Stages of every step beside the cloth's forces (contact), in the order added.
     stages: Vec<Box<dyn StepStage>>,
     filter: Filter,
@@ -184,6 +186,7 @@ impl Simulation {
             state,
             params,
             attachments: Vec::new(),
+            gravity_share: 1.0,
             stages: Vec::new(),
             stats: Vec::new(),
             sewing: None,
@@ -324,7 +327,7 @@ impl Simulation {
     pub fn energy(&mut self) -> (f64, f64, f64) {
         let inp = AssemblyInputs {
             dt: self.params.dt,
-            gravity: Vec3::from(self.params.gravity),
+            gravity: self.gravity(),
             matrix: false,
         };
         let commit = std::mem::replace(&mut self.asm.auto_commit, false);
@@ -336,8 +339,13 @@ impl Simulation {
         (k, g, elastic)
     }
 
+    /// The gravity acting: the parameters' times the share the sewing lets act.
+    fn gravity(&self) -> Vec3 {
+        Vec3::from(self.params.gravity) * self.gravity_share
+    }
+
     fn kinetic_gravity(&self) -> (f64, f64) {
-        let gr = Vec3::from(self.params.gravity);
+        let gr = self.gravity();
         let (mut k, mut g) = (0.0, 0.0);
         for i in 0..self.particle_count() {
             let m = self.model.mass[i];
@@ -384,7 +392,7 @@ impl Simulation {
         self.params.validate()?;
         let t_start = Instant::now();
         if let Some(sew) = &mut self.sewing {
-            self.params.gravity = sew.update(&mut self.model, self.state.time, &self.state.x);
+            self.gravity_share = sew.update(&mut self.model, self.state.time, &self.state.x);
             for stage in &mut self.stages {
                 stage.follow_sewing(sew, self.state.time);
             }
@@ -467,7 +475,7 @@ impl Simulation {
         let t0 = Instant::now();
         let inp = AssemblyInputs {
             dt: h,
-            gravity: Vec3::from(self.params.gravity),
+            gravity: self.gravity(),
             matrix: true,
         };
         let elastic = self
@@ -599,7 +607,7 @@ impl Simulation {
     fn step_explicit(&mut self) -> StepStats {
         let sub = self.params.explicit_substeps.max(1);
         let h = self.params.dt / sub as f64;
-        let gravity = Vec3::from(self.params.gravity);
+        let gravity = self.gravity();
         let (kinetic, grav) = self.kinetic_gravity();
         let mut elastic0 = 0.0;
         let t0 = Instant::now();

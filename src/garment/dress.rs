@@ -161,7 +161,6 @@ pub fn dress(
         &x,
         (params.seam_stiffness, params.seam_max_force),
         params.sewing_speed,
-        sim_params.gravity,
     );
     if params.seam_hinges {
         sewing.add_hinges(&mut model, seam_hinges(&garment));
