@@ -64,7 +64,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let mut d = dress(&pattern, fabric, &man, &params, sim_params)?;
     if let Some(law) = law {
-        d.simulation.model.set_law(law);
+        d.simulation.set_material(law)?;
     }
     println!("{}", serde_json::to_string(&d.report)?);
     println!("set up in {:.2} s", t0.elapsed().as_secs_f64());

@@ -2,12 +2,14 @@
 //! implicit (Baraff–Witkin) or the explicit (symplectic Euler) integrator. Every step checks
 //! for divergence and leaves the state untouched when it fails.
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
 use super::buckling::buckling_side::BucklingSides;
 use super::constraints::{Attachment, Filter, ParticleFilter, Trajectory};
+use super::elements::material::MaterialLaw;
 use super::model::ClothModel;
 use super::sewing::Sewing;
 use super::solver::amg::AggregationMultigrid;
@@ -114,6 +116,36 @@ impl SimulationParameters {
     }
 }
 
+/// A simulation's geometric and aggregation multigrid, either or both absent.
+type Preconditioners = (Option<Multigrid>, Option<AggregationMultigrid>);
+
+/// The multigrid preconditioners `params` asks for on `model`, whose implicit system `asm`
+/// assembles (none: block-Jacobi, which `asm` then forms during assembly).
+fn preconditioners(
+    model: &ClothModel,
+    params: &SimulationParameters,
+    asm: &mut Assembly,
+) -> Result<Preconditioners, ClothError> {
+    let mg = match (params.preconditioner, model.grid) {
+        (PreconditionerKind::BlockJacobi, _) => None,
+        (PreconditionerKind::Auto, Some((nx, ny))) if nx.min(ny) >= 16 => {
+            Some(Multigrid::new(model, &mut asm.a)?)
+        }
+        (PreconditionerKind::Multigrid, _) => Some(Multigrid::new(model, &mut asm.a)?),
+        _ => None,
+    };
+    let amg = match params.preconditioner {
+        PreconditionerKind::Aggregation => Some(AggregationMultigrid::new(model, &asm.a)),
+        PreconditionerKind::Auto if mg.is_none() && model.particle_count() >= AGGREGATION_MIN => {
+            Some(AggregationMultigrid::new(model, &asm.a))
+        }
+        _ => None,
+    };
+    // a multigrid enabled the single-precision mirrors its smoother reads
+    asm.jacobi = mg.is_none() && amg.is_none();
+    Ok((mg, amg))
+}
+
 /// A running cloth simulation.
 #[derive(Debug)]
 pub struct Simulation {
@@ -158,25 +190,7 @@ impl Simulation {
         let n = model.particle_count();
         let mut asm = Assembly::new(&model);
         let state = ClothState::at_rest(model.mesh.positions.clone());
-        let mg = match (params.preconditioner, model.grid) {
-            (PreconditionerKind::BlockJacobi, _) => None,
-            (PreconditionerKind::Auto, Some((nx, ny))) if nx.min(ny) >= 16 => {
-                Some(Multigrid::new(&model, &mut asm.a)?)
-            }
-            (PreconditionerKind::Multigrid, _) => Some(Multigrid::new(&model, &mut asm.a)?),
-            _ => None,
-        };
-        let amg = match params.preconditioner {
-            PreconditionerKind::Aggregation => Some(AggregationMultigrid::new(&model, &asm.a)),
-            PreconditionerKind::Auto if mg.is_none() && n >= AGGREGATION_MIN => {
-                Some(AggregationMultigrid::new(&model, &asm.a))
-            }
-            _ => None,
-        };
-        if mg.is_some() || amg.is_some() {
-            // the multigrid enabled the single-precision mirrors its smoother reads
-            asm.jacobi = false;
-        }
+        let (mg, amg) = preconditioners(&model, &params, &mut asm)?;
         let sides = (model.choi_ko && !model.flexion_sides.is_empty())
             .then(|| BucklingSides::new(model.flexion_sides.clone(), model.choi_ko_seed));
         Ok(Simulation {
@@ -202,6 +216,16 @@ impl Simulation {
             amg,
             model,
         })
+    }
+
+    /// Gives the cloth another material law (a measured one, say) and rebuilds what was made
+    /// from the old one (the geometric multigrid's coarse cloths).
+    pub fn set_material(&mut self, law: Arc<dyn MaterialLaw>) -> Result<(), ClothError> {
+        self.model.set_law(law);
+        let (mg, amg) = preconditioners(&self.model, &self.params, &mut self.asm)?;
+        self.mg = mg;
+        self.amg = amg;
+        Ok(())
     }
 
     /// Multigrid time spent so far: (setup s, V-cycles s, V-cycle count); `None` without multigrid.
@@ -339,8 +363,9 @@ impl Simulation {
         (k, g, elastic)
     }
 
-    /// The gravity acting: the parameters' times the share the sewing lets act.
-    fn gravity(&self) -> Vec3 {
+    /// The gravity acting now (m/s²): the parameters' times the share a garment's sewing
+    /// lets act.
+    pub fn gravity(&self) -> Vec3 {
         Vec3::from(self.params.gravity) * self.gravity_share
     }
 
