@@ -8,6 +8,7 @@ pub mod constraints;
 pub mod elements;
 pub mod error;
 pub mod model;
+pub mod parameters;
 pub mod sewing;
 pub mod simulation;
 pub mod solver;
@@ -20,8 +21,9 @@ pub use elements::material::{Direction, FabricParameters, Friction, LinearMateri
 pub use elements::measured::{MeasuredLaw, ResponseCurve};
 pub use error::ClothError;
 pub use model::ClothModel;
+pub use parameters::{Integrator, PreconditionerKind, SimulationParameters};
 pub use sewing::{Separation, Sewing};
-pub use simulation::{Integrator, PreconditionerKind, Simulation, SimulationParameters};
+pub use simulation::Simulation;
 pub use stage::{Obstacles, StepEnd, StepStage};
 pub use state::ClothState;
 pub use stats::StepStats;
