@@ -5,6 +5,7 @@
 //! exact geometric primitives they rest on.
 
 pub mod body;
+pub mod body_pin;
 pub mod ccd;
 pub mod character;
 pub mod collisions;
