@@ -1,6 +1,7 @@
 //! Euler buckling and post-buckling of a compressed strip against the analytic answers of the
-//! maths notes §5.3 (the pinned elastica table), and Choi & Ko's immediate-buckling force
-//! against the same elastica.
+//! maths notes §5.3 (the pinned elastica table), Choi & Ko's immediate-buckling force
+//! against the same elastica, and the compression-release model on a garment pattern's
+//! triangle mesh.
 
 use std::sync::Arc;
 
