@@ -3,6 +3,7 @@
 //!
 //! `cargo run --release --example drape -- [n] [self]`
 
+use emilion::contact::SimulationContact;
 use emilion::geometry::mesh::bounds;
 use emilion::geometry::LookAtCamera;
 use emilion::render::{render_png, RenderMesh};
@@ -15,22 +16,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut p = sim.params;
         p.preconditioner = emilion::cloth::PreconditionerKind::BlockJacobi;
         let mut s2 = emilion::cloth::Simulation::new(sim.model.clone(), p)?;
-        s2.contact.settings = sim.contact.settings;
-        s2.contact.bodies = sim.contact.bodies.clone();
+        let contact = s2.add_contact();
+        contact.settings = sim.contact().settings;
+        contact.bodies = sim.contact().bodies.clone();
         sim = s2;
     }
     if let Ok(mu) = std::env::var("MU") {
         let mu: f64 = mu.parse()?;
-        sim.contact.settings.friction = emilion::contact::FrictionCoefficients {
+        let contact = sim.contact_mut();
+        contact.settings.friction = emilion::contact::FrictionCoefficients {
             static_: mu,
             kinetic: mu,
         };
-        for b in &mut sim.contact.bodies {
-            b.friction = sim.contact.settings.friction;
+        for b in &mut contact.bodies {
+            b.friction = contact.settings.friction;
         }
     }
     if args.get(2).is_some_and(|s| s == "self") {
-        sim.contact.settings.self_collision = true;
+        sim.contact_mut().settings.self_collision = true;
     }
     let frames: u32 = std::env::var("FRAMES").map_or(50, |f| f.parse().unwrap_or(50));
     for frame in 1..=frames {

@@ -17,7 +17,7 @@ use std::time::Instant;
 
 use emilion::body::Mannequin;
 use emilion::cloth::{FabricParameters, SimulationParameters};
-use emilion::contact::Shape;
+use emilion::contact::{Shape, SimulationContact};
 use emilion::garment::{dress, read_garment, DressParameters};
 use emilion::geometry::LookAtCamera;
 use emilion::geometry::Vec3;
@@ -65,7 +65,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let mut d = dress(&pattern, fabric, &man, &params, sim_params)?;
     if let Some(law) = law {
-        d.simulation.model.set_law(law);
+        d.simulation.set_material(law)?;
     }
     println!("{}", serde_json::to_string(&d.report)?);
     println!("set up in {:.2} s", t0.elapsed().as_secs_f64());
@@ -140,7 +140,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                         .fold(0.0, f64::max);
                     print!("{}:{:.1} ", s.name, g * 1e3);
                 }
-                let list = sim.contact.self_intersections(&sim.state.x);
+                let x = sim.state.x.clone();
+                let list = sim.contact_mut().self_intersections(&x);
                 let crossings = list.len();
                 let mut by: std::collections::BTreeMap<(usize, usize), usize> = Default::default();
                 for (e, t) in &list {
@@ -189,7 +190,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
         if std::env::var("DIAG").is_ok() && worst.1 > 1e-3 {
             let (a, b) = s.pairs[worst.0];
-            if let Shape::Mesh(m) = &sim.contact.bodies[0].shape {
+            if let Shape::Mesh(m) = &sim.contact().bodies[0].shape {
                 for v in [a, b] {
                     let dist = m.proximity(&x[v], 1.0).map_or(f64::NAN, |q| q.distance);
                     println!(
@@ -204,7 +205,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
     }
-    if let Shape::Mesh(m) = &sim.contact.bodies[0].shape {
+    if let Shape::Mesh(m) = &sim.contact().bodies[0].shape {
         let mut inside: Vec<(f64, usize)> = sim
             .state
             .x
@@ -228,7 +229,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             );
         }
     }
-    let n = sim.contact.report(&sim.state.x).intersections;
+    let x = sim.state.x.clone();
+    let n = sim.contact_mut().report(&x).intersections;
     if std::env::var("DIAG").is_ok() {
         let mut owner = vec![0usize; sim.state.x.len()];
         for (k, p) in d.garment.pieces.iter().enumerate() {
@@ -238,7 +240,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         let mut by: std::collections::BTreeMap<(String, String), (usize, Vec3)> =
             Default::default();
-        for (e, t) in sim.contact.self_intersections(&sim.state.x) {
+        for (e, t) in sim.contact_mut().self_intersections(&x) {
             let (a, b) = (owner[e[0] as usize], owner[t[0] as usize]);
             let key = (
                 d.garment.pieces[a.min(b)].name.clone(),
@@ -319,7 +321,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         None => println!("; block-Jacobi"),
     }
     std::fs::create_dir_all("out/examples")?;
-    let (bp, bt) = match &sim.contact.bodies[0].shape {
+    let (bp, bt) = match &sim.contact().bodies[0].shape {
         Shape::Mesh(m) => (m.positions().to_vec(), m.triangles().to_vec()),
         _ => unreachable!(),
     };

@@ -6,7 +6,7 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use emilion::cloth::choi_ko::buckling_force;
+use emilion::cloth::buckling::choi_ko::buckling_force;
 use emilion::cloth::{FabricParameters, MaterialLaw};
 use emilion::kes::compression::{Strip, StripEnds};
 use emilion::render::plot::{write_plot_pair, write_series_csv, PlotSpec, Series, SeriesStyle};

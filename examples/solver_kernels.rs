@@ -1,7 +1,7 @@
 //! Times the solver kernels (assembly, block product, line factorisation and sweeps) on the
 //! benchmark scene after 20 steps: `cargo run --release --example solver_kernels -- 256`.
-use emilion::cloth::assembly::{Assembly, AssemblyInputs};
-use emilion::cloth::line_solver::{LineDir, LineSolver};
+use emilion::cloth::solver::assembly::{Assembly, AssemblyInputs};
+use emilion::cloth::solver::line_solver::{LineDir, LineSolver};
 use emilion::geometry::Vec3;
 use std::time::Instant;
 fn main() {

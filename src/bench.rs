@@ -7,6 +7,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::cloth::ClothError;
+use crate::contact::SimulationContact;
 use crate::scenes;
 
 /// One benchmark case's result.
@@ -91,12 +92,14 @@ pub fn bench_scene(
         };
         // per-step intersection counting is a diagnostic, not part of the solver: the final
         // state is checked once after the timed loop
-        sim.contact.settings.count_intersections = false;
+        sim.add_contact().settings.count_intersections = false;
         let steps = (frames * substeps) as u64;
         let t0 = Instant::now();
         sim.run_steps(steps, |_, _| Ok(()))?;
         let ms = t0.elapsed().as_secs_f64() * 1e3 / steps as f64;
         if r > 0 {
+            let x = sim.state.x.clone();
+            let last = sim.contact_mut().report(&x);
             let s = &sim.stats;
             let k = s.len() as f64;
             let iters = s.iter().map(|x| x.cg_iterations as f64).sum::<f64>() / k;
@@ -108,8 +111,6 @@ pub fn bench_scene(
             let setup_ms = setup * 1e3 / k;
             let vcycle_ms = apply * 1e3 / (cycles.max(1) as f64);
             let cm = s.iter().map(|x| x.collision_ms).sum::<f64>() / k;
-            let x = sim.state.x.clone();
-            let last = sim.contact.report(&x);
             let md = s
                 .iter()
                 .map(|x| x.min_distance)

@@ -7,10 +7,8 @@ use std::path::{Path, PathBuf};
 use indicatif::ProgressBar;
 
 use crate::cloth::stats::write_csv;
-use crate::cloth::{
-    ClothError, ClothModel, FabricParameters, Floor, Simulation, SimulationParameters,
-};
-use crate::contact::Body;
+use crate::cloth::{ClothError, ClothModel, FabricParameters, Simulation, SimulationParameters};
+use crate::contact::{Body, Floor, SimulationContact};
 use crate::geometry::mesh::bounds;
 use crate::geometry::LookAtCamera;
 use crate::geometry::Vec3;
@@ -45,8 +43,9 @@ pub fn drape(n: usize) -> Result<Simulation, ClothError> {
         ..Default::default()
     };
     let mut sim = Simulation::new(model, params)?;
-    sim.contact.settings.thickness = 0.015;
-    sim.contact.bodies.push(Body::sphere(Vec3::zeros(), 0.3)?);
+    let contact = sim.add_contact();
+    contact.settings.thickness = 0.015;
+    contact.bodies.push(Body::sphere(Vec3::zeros(), 0.3)?);
     Ok(sim)
 }
 
@@ -54,8 +53,9 @@ pub fn drape(n: usize) -> Result<Simulation, ClothError> {
 /// diagonal half-spacing at n = 64 is 0.011 m, so Blender's 0.015 m would repel neighbours at rest).
 pub fn hang_self(n: usize) -> Result<Simulation, ClothError> {
     let mut sim = hang(n)?;
-    sim.contact.settings.self_collision = true;
-    sim.contact.settings.self_thickness = 0.005;
+    let contact = sim.add_contact();
+    contact.settings.self_collision = true;
+    contact.settings.self_thickness = 0.005;
     Ok(sim)
 }
 
@@ -67,7 +67,7 @@ pub fn hang_self(n: usize) -> Result<Simulation, ClothError> {
 pub fn demo(out_dir: &Path) -> Result<Vec<PathBuf>, ClothError> {
     let n = 48;
     let mut sim = hang(n)?;
-    sim.add_hook(Box::new(Floor {
+    sim.add_stage(Box::new(Floor {
         height: -1.2,
         thickness: 0.005,
     }));

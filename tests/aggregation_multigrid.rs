@@ -6,7 +6,7 @@
 use emilion::cloth::{
     ClothModel, FabricParameters, PreconditionerKind, Simulation, SimulationParameters,
 };
-use emilion::contact::Body;
+use emilion::contact::{Body, SimulationContact};
 use emilion::geometry::Vec3;
 
 fn params(kind: PreconditionerKind) -> SimulationParameters {
@@ -31,7 +31,7 @@ fn drop_on_ball(n: usize, params: SimulationParameters) -> Simulation {
         *p += Vec3::new(-0.3, -0.3, 0.22);
     }
     let mut sim = Simulation::new(model, params).unwrap();
-    sim.contact
+    sim.add_contact()
         .bodies
         .push(Body::sphere(Vec3::zeros(), 0.2).unwrap());
     sim

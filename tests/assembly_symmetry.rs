@@ -7,7 +7,7 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use emilion::cloth::assembly::{Assembly, AssemblyInputs};
+use emilion::cloth::solver::assembly::{Assembly, AssemblyInputs};
 use emilion::cloth::{ClothModel, FabricParameters, MaterialLaw};
 use emilion::geometry::Vec3;
 use emilion::kes::{lab, read_fabric};

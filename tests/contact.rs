@@ -5,7 +5,7 @@
 mod support;
 
 use emilion::cloth::{ClothModel, FabricParameters, Simulation, SimulationParameters};
-use emilion::contact::{Body, FrictionCoefficients, MeshBody};
+use emilion::contact::{Body, FrictionCoefficients, MeshBody, SimulationContact};
 use emilion::geometry::Vec3;
 use nalgebra::{Rotation3, Vector3};
 
@@ -28,9 +28,9 @@ fn incline_slip(deg: f64, mu: f64, seconds: f64) -> f64 {
     };
     let mut plane = Body::plane(Vec3::zeros(), normal).unwrap();
     plane.friction = f;
-    sim.contact.bodies.push(plane);
-    sim.contact.settings.thickness = thickness;
-    sim.contact.settings.friction = f;
+    sim.add_contact().bodies.push(plane);
+    sim.add_contact().settings.thickness = thickness;
+    sim.add_contact().settings.friction = f;
     let centre = |s: &Simulation| s.state.x.iter().sum::<Vec3>() / s.state.x.len() as f64;
     let c0 = centre(&sim);
     let steps = sim.steps_for(seconds);
@@ -81,9 +81,9 @@ fn strip_pushed_on_a_frictional_plane_by_its_attached_end_keeps_the_end_on_targe
     };
     let mut plane = Body::plane(Vec3::zeros(), Vec3::z()).unwrap();
     plane.friction = f;
-    sim.contact.bodies.push(plane);
-    sim.contact.settings.thickness = thickness;
-    sim.contact.settings.friction = f;
+    sim.add_contact().bodies.push(plane);
+    sim.add_contact().settings.thickness = thickness;
+    sim.add_contact().settings.friction = f;
     // settle on the plane, then push the +x end towards −x
     let settle = sim.steps_for(0.1);
     sim.run_steps(settle, |_, _| Ok(())).unwrap();
@@ -131,7 +131,7 @@ fn check_no_self_intersection(model: ClothModel) {
     let exact = exact_intersections(&model.mesh.positions, &model.mesh.triangles);
     let mut sim = Simulation::new(model, SimulationParameters::default()).unwrap();
     let x = sim.state.x.clone();
-    let fast = sim.contact.report(&x).intersections;
+    let fast = sim.add_contact().report(&x).intersections;
     assert_eq!(exact, 0);
     assert_eq!(fast, 0);
 }
@@ -320,9 +320,9 @@ fn cloth_draped_on_a_sphere_comes_to_rest_without_contact_chatter() {
     };
     let mut ball = Body::sphere(Vec3::zeros(), 0.15).unwrap();
     ball.friction = f;
-    sim.contact.bodies.push(ball);
-    sim.contact.settings.thickness = 0.004;
-    sim.contact.settings.friction = f;
+    sim.add_contact().bodies.push(ball);
+    sim.add_contact().settings.thickness = 0.004;
+    sim.add_contact().settings.friction = f;
     let steps = sim.steps_for(2.5);
     sim.run_steps(steps, |_, _| Ok(())).unwrap();
     let (mut lo, mut hi, mut fastest) = (usize::MAX, 0, 0.0f64);

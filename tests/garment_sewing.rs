@@ -57,7 +57,7 @@ fn sew_at(
     .unwrap();
     let sim = &mut d.simulation;
     if let Some(law) = law {
-        sim.model.set_law(Arc::new(law));
+        sim.set_material(Arc::new(law)).unwrap();
     }
     let steps = sim.steps_for(seconds);
     sim.run_steps(steps, |_, _| Ok(())).unwrap();
@@ -65,7 +65,7 @@ fn sew_at(
     // every failure is collected, so one run reports them all
     let mut failures = Vec::new();
     // gravity is on: the seams closed and the garment settled
-    if sim.params.gravity[2] > -9.0 {
+    if sim.gravity()[2] > -9.0 {
         failures.push("still sewing at the end".to_string());
     }
     // every seam closed to a millimetre

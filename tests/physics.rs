@@ -436,15 +436,15 @@ fn bad_parameters_are_named() {
     assert!(sim.pin(&[99]).unwrap_err().to_string().contains("99"));
 }
 
-/// The floor, the example contact hook: a cloth dropped flat from 0.3 m lands and rests on
+/// The floor, the simplest step stage: a cloth dropped flat from 0.3 m lands and rests on
 /// the contact surface (floor height + thickness), never below the floor.
 #[test]
 fn dropped_cloth_rests_on_the_floor() {
-    use emilion::cloth::Floor;
+    use emilion::contact::Floor;
     let model = ClothModel::grid(0.6, 0.6, 20, 20, FabricParameters::default()).unwrap();
     let mut sim = Simulation::new(model, SimulationParameters::default()).unwrap();
     let (height, thickness) = (-0.3, 0.004);
-    sim.add_hook(Box::new(Floor { height, thickness }));
+    sim.add_stage(Box::new(Floor { height, thickness }));
     sim.run_steps(240, |s, _| {
         let low = s.state.x.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
         assert!(low >= height, "particle below the floor: z = {low}");

@@ -113,14 +113,7 @@ fn sewing_caps_the_motion_of_every_step() {
     let x = model.mesh.positions.clone();
     // a slow thread between opposite corners, and the cloth laid out stretched by 30 % (as a
     // pre-positioned garment may be locally): its recoil is far faster than sewing allows
-    let sewing = Sewing::add_to(
-        &mut model,
-        &[(0, n * n - 1)],
-        &x,
-        (300.0, 5.0),
-        0.3,
-        [0.0; 3],
-    );
+    let sewing = Sewing::add_to(&mut model, &[(0, n * n - 1)], &x, (300.0, 5.0), 0.3);
     let limit = sewing.max_speed;
     let params = SimulationParameters::default();
     let dt = params.dt;

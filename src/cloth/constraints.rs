@@ -1,10 +1,9 @@
 //! Constraints that enter the implicit solve through Baraff–Witkin's per-particle filter S and
-//! prescribed velocity change z: pinned particles, particles attached to a moving target, and a
-//! hook through which contact handlers constrain particles along a normal.
+//! prescribed velocity change z: pinned particles, particles attached to a moving target, and
+//! particles whose velocity along a normal a step stage prescribes (contact).
 
 use serde::{Deserialize, Serialize};
 
-use crate::contact::Body;
 use crate::geometry::Vec3;
 
 /// A rigid translation over time, applied to attached particles' anchor positions.
@@ -205,92 +204,6 @@ impl Filter {
                 w - free * free.dot(&w)
             }
             ParticleFilter::Normal { normal, velocity } => normal * (velocity - normal.dot(v)),
-        }
-    }
-}
-
-/// A contact handler: before each step it constrains particles in contact through the filter
-/// (normal direction, S = I − n nᵀ, with the normal velocity it wants), after the step it may
-/// correct positions. Implemented by obstacles (the floor here, bodies in the contact issue).
-pub trait ContactHook: Send + Sync + std::fmt::Debug {
-    /// Adds contact constraints for the step from `t` to `t + dt`; `obstacles` are the
-    /// simulation's collision bodies, for hooks that must not send particles into them.
-    fn constrain(
-        &mut self,
-        x: &[Vec3],
-        v: &[Vec3],
-        t: f64,
-        dt: f64,
-        filter: &mut Filter,
-        obstacles: Obstacles<'_>,
-    );
-    /// Corrects positions and velocities after the step (default: nothing).
-    fn correct(&mut self, _x: &mut [Vec3], _v: &mut [Vec3]) {}
-}
-
-/// An infinite horizontal floor at `height` (z up): particles closer than `thickness` and
-/// moving down get their normal velocity set so they rest at `height + thickness`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Floor {
-    /// Floor height (m).
-    pub height: f64,
-    /// Contact distance kept between cloth and floor (m).
-    pub thickness: f64,
-}
-
-/// The simulation's collision bodies as a contact hook sees them.
-#[derive(Debug, Clone, Copy)]
-pub struct Obstacles<'a> {
-    /// The bodies.
-    pub bodies: &'a [Body],
-    /// Distance the cloth keeps from them (m).
-    pub clearance: f64,
-}
-
-impl Obstacles<'_> {
-    /// No bodies.
-    pub fn none() -> Obstacles<'static> {
-        Obstacles {
-            bodies: &[],
-            clearance: 0.0,
-        }
-    }
-
-    /// Whether `p` is at least the clearance away from every body (outside all of them).
-    pub fn is_clear(&self, p: &Vec3) -> bool {
-        self.bodies
-            .iter()
-            .all(|b| b.proximity(p, self.clearance).is_none())
-    }
-}
-
-impl ContactHook for Floor {
-    fn constrain(
-        &mut self,
-        x: &[Vec3],
-        v: &[Vec3],
-        _t: f64,
-        dt: f64,
-        filter: &mut Filter,
-        _obstacles: Obstacles<'_>,
-    ) {
-        let rest = self.height + self.thickness;
-        for i in 0..x.len() {
-            let gap = x[i].z - rest;
-            // will it reach the contact distance during this step?
-            if gap + v[i].z.min(0.0) * dt <= 0.0 {
-                filter.constrain_normal(i, Vec3::z(), (-gap / dt).max(0.0));
-            }
-        }
-    }
-
-    fn correct(&mut self, x: &mut [Vec3], v: &mut [Vec3]) {
-        let floor = self.height;
-        for i in 0..x.len() {
-            if x[i].z < floor {
-                x[i].z = floor;
-                v[i].z = v[i].z.max(0.0);
-            }
         }
     }
 }

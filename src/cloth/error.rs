@@ -8,9 +8,9 @@ pub enum ClothError {
     /// A parameter is out of range (names the parameter).
     #[error("{0}")]
     Parameter(String),
-    /// A collision body or contact setting is invalid.
+    /// A step stage failed (a collision body or contact setting is invalid).
     #[error(transparent)]
-    Contact(#[from] crate::contact::ContactError),
+    Stage(Box<dyn std::error::Error + Send + Sync>),
     /// The mesh is invalid or a file could not be read.
     #[error(transparent)]
     Geometry(#[from] GeometryError),

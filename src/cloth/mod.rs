@@ -1,37 +1,29 @@
-//! Cloth: particle state, force elements and material laws, the block-sparse implicit solver
-//! (Baraff & Witkin) and the explicit one, constraints (pins, attachments, contact hook),
-//! per-step statistics.
+//! Cloth: particle state, force elements and material laws ([`elements`]), the block-sparse
+//! implicit solver (Baraff & Witkin, [`solver`]) and the explicit one, the buckling models
+//! ([`buckling`]), constraints (pins, attachments, the filter), the step stages through which
+//! contact takes part in a step, per-step statistics.
 
-pub mod aggregation;
-pub mod amg;
-pub mod arc_connection;
-pub mod assembly;
-pub mod bcsr;
-pub mod buckling_side;
-pub mod choi_ko;
-pub mod compression_release;
+pub mod buckling;
 pub mod constraints;
 pub mod elements;
 pub mod error;
-pub mod line_solver;
-pub mod material;
-pub mod measured;
 pub mod model;
-pub mod multigrid;
-pub mod parallel;
-pub mod pcg;
+pub mod parameters;
 pub mod sewing;
 pub mod simulation;
+pub mod solver;
+pub mod stage;
 pub mod state;
 pub mod stats;
-pub mod wrinkles;
 
-pub use constraints::{Attachment, ContactHook, Filter, Floor, Obstacles, Trajectory};
+pub use constraints::{Attachment, Filter, Trajectory};
+pub use elements::material::{Direction, FabricParameters, Friction, LinearMaterial, MaterialLaw};
+pub use elements::measured::{MeasuredLaw, ResponseCurve};
 pub use error::ClothError;
-pub use material::{Direction, FabricParameters, Friction, LinearMaterial, MaterialLaw};
-pub use measured::{MeasuredLaw, ResponseCurve};
 pub use model::ClothModel;
+pub use parameters::{Integrator, PreconditionerKind, SimulationParameters};
 pub use sewing::{Separation, Sewing};
-pub use simulation::{Integrator, PreconditionerKind, Simulation, SimulationParameters};
+pub use simulation::Simulation;
+pub use stage::{Obstacles, StepEnd, StepStage};
 pub use state::ClothState;
 pub use stats::StepStats;

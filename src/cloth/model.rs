@@ -3,10 +3,10 @@
 
 use std::sync::Arc;
 
-use super::arc_connection::ArcConnection;
-use super::buckling_side::{turns_left, FlexionSide};
+use super::buckling::arc_connection::ArcConnection;
+use super::buckling::buckling_side::{turns_left, FlexionSide};
+use super::elements::material::{Direction, FabricParameters, MaterialLaw};
 use super::elements::{BendLine, Hinge, ShearQuad, Spring, SpringKind};
-use super::material::{Direction, FabricParameters, MaterialLaw};
 use super::ClothError;
 use crate::geometry::{grid_mesh, Topology, TriMesh};
 
@@ -39,7 +39,7 @@ pub struct ClothModel {
     /// Whether Choi & Ko's buckling model is on (see [`ClothModel::enable_choi_ko`]).
     pub choi_ko: bool,
     /// Choi–Ko's connections as the choice of their buckling side sees them (see
-    /// [`super::buckling_side`]); empty without Choi–Ko.
+    /// [`super::buckling::buckling_side`]); empty without Choi–Ko.
     pub flexion_sides: Vec<FlexionSide>,
     /// Seed of the random side a flat Choi–Ko connection buckles to.
     pub choi_ko_seed: u64,
@@ -242,7 +242,7 @@ impl ClothModel {
     /// friction fixed and contacts at rest it no longer crumples, but it stores the push as in-plane
     /// shortening (5–7 % of the springs shorter by 1 %, no visible wrinkles, 0.021–0.030 J at
     /// rest against 0.016–0.025 J without type-1 on seeds 1–8). Since flat connections start
-    /// their arcs on a chosen side ([`super::buckling_side`]), the flat square no longer keeps
+    /// their arcs on a chosen side ([`super::buckling::buckling_side`]), the flat square no longer keeps
     /// half its springs compressed with type-1, but the cloth on the cylinder still stores the
     /// push in its plane (6.5 % of the springs compressed, 0.0265 J against 0.0139 J without a
     /// model, seeds 1–8, 2026-12-05).

@@ -73,9 +73,7 @@ pub struct Sewing {
     /// Largest particle speed while sewing (m/s): sewing is slow, so that contact with the
     /// body, which looks one step ahead, always sees the cloth coming.
     pub max_speed: f64,
-    /// Gravity once sewn (m/s²).
-    pub gravity: [f64; 3],
-    /// Share of gravity acting while sewing (0: none).
+    /// Share of the simulation's gravity acting while sewing (0: none; all of it once sewn).
     pub sewing_gravity: f64,
     /// A seam counts as closed when no sewn pair is further apart than this (m).
     pub closed_gap: f64,
@@ -107,7 +105,6 @@ impl Sewing {
         x: &[Vec3],
         (stiffness, max_force): (f64, f64),
         speed: f64,
-        gravity: [f64; 3],
     ) -> Sewing {
         let start = model.springs.len();
         let mut initial = Vec::with_capacity(pairs.len());
@@ -132,7 +129,6 @@ impl Sewing {
             settle: 0.1,
             damping: 0.9,
             max_speed: 2.0 * speed,
-            gravity,
             sewing_gravity: 0.0,
             closed_gap: 0.002,
             max_time: 3.0,
@@ -177,8 +173,8 @@ impl Sewing {
     }
 
     /// Sets the threads' rest lengths for time `t` (the cloth at `x`), notes when the seams
-    /// have closed, and returns the gravity to use.
-    pub fn update(&mut self, model: &mut ClothModel, t: f64, x: &[Vec3]) -> [f64; 3] {
+    /// have closed, and returns the share of the simulation's gravity that acts.
+    pub fn update(&mut self, model: &mut ClothModel, t: f64, x: &[Vec3]) -> f64 {
         for (k, s) in model.springs[self.springs.clone()].iter_mut().enumerate() {
             s.rest = (self.initial[k] - self.speed * t).max(0.0);
         }
@@ -203,9 +199,9 @@ impl Sewing {
             }
         }
         if self.sewing_at(t) {
-            self.gravity.map(|g| g * self.sewing_gravity)
+            self.sewing_gravity
         } else {
-            self.gravity
+            1.0
         }
     }
 

@@ -1,117 +1,54 @@
-//! `Simulation`: a cloth model, its state, constraints and contact hooks, stepped by the
+//! `Simulation`: a cloth model, its state, constraints and step stages, stepped by the
 //! implicit (Baraff–Witkin) or the explicit (symplectic Euler) integrator. Every step checks
 //! for divergence and leaves the state untouched when it fails.
 
+use std::sync::Arc;
 use std::time::Instant;
 
-use serde::{Deserialize, Serialize};
-
-use super::amg::AggregationMultigrid;
-use super::assembly::{Assembly, AssemblyInputs};
-use super::buckling_side::BucklingSides;
-use super::constraints::{Attachment, ContactHook, Filter, Obstacles, ParticleFilter, Trajectory};
+use super::buckling::buckling_side::BucklingSides;
+use super::constraints::{Attachment, Filter, ParticleFilter, Trajectory};
+use super::elements::material::MaterialLaw;
 use super::model::ClothModel;
-use super::multigrid::Multigrid;
-use super::pcg::{PcgResult, PcgWorkspace, Preconditioner};
+use super::parameters::{Integrator, PreconditionerKind, SimulationParameters, AGGREGATION_MIN};
 use super::sewing::Sewing;
+use super::solver::amg::AggregationMultigrid;
+use super::solver::assembly::{Assembly, AssemblyInputs};
+use super::solver::multigrid::Multigrid;
+use super::solver::pcg::{PcgResult, PcgWorkspace, Preconditioner};
+use super::stage::{Obstacles, StepEnd, StepStage};
 use super::state::ClothState;
 use super::stats::StepStats;
 use super::ClothError;
-use crate::contact::Collisions;
 use crate::geometry::Vec3;
 
-/// Time integrator.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Integrator {
-    /// Linearised backward Euler with the modified PCG (Baraff & Witkin).
-    Implicit,
-    /// Symplectic Euler with `explicit_substeps` substeps per step.
-    Explicit,
-}
+/// A simulation's geometric and aggregation multigrid, either or both absent.
+type Preconditioners = (Option<Multigrid>, Option<AggregationMultigrid>);
 
-/// Which preconditioner the implicit solve uses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum PreconditionerKind {
-    /// Multigrid on grid cloths of at least 16 × 16 particles, aggregation multigrid on other
-    /// cloths of at least `AGGREGATION_MIN` particles, block-Jacobi otherwise.
-    Auto,
-    /// Inverse diagonal 3×3 blocks.
-    BlockJacobi,
-    /// Geometric multigrid V-cycle with line smoothing (grid cloths only).
-    Multigrid,
-    /// Aggregation (algebraic) multigrid V-cycle with block Gauss–Seidel smoothing (any mesh).
-    Aggregation,
-}
-
-/// Smallest non-grid cloth that [`PreconditionerKind::Auto`] preconditions with aggregation
-/// multigrid.
-pub const AGGREGATION_MIN: usize = 1000;
-
-/// Settings of a simulation, SI units; every field settable on its own.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
-pub struct SimulationParameters {
-    /// Step length (s).
-    pub dt: f64,
-    /// Which integrator advances the state.
-    pub integrator: Integrator,
-    /// Gravity (m/s²).
-    pub gravity: [f64; 3],
-    /// CG relative residual tolerance.
-    pub cg_tolerance: f64,
-    /// CG iteration cap.
-    pub cg_max_iterations: u32,
-    /// Start CG from the previous step's velocity change.
-    pub warm_start: bool,
-    /// Substeps per step for the explicit integrator.
-    pub explicit_substeps: u32,
-    /// A particle faster than this (m/s) means the simulation blew up.
-    pub max_speed: f64,
-    /// Preconditioner of the implicit solve.
-    pub preconditioner: PreconditionerKind,
-}
-
-impl Default for SimulationParameters {
-    fn default() -> Self {
-        SimulationParameters {
-            dt: 1.0 / 120.0,
-            integrator: Integrator::Implicit,
-            gravity: [0.0, 0.0, -9.81],
-            cg_tolerance: 1e-3,
-            cg_max_iterations: 500,
-            warm_start: true,
-            explicit_substeps: 1,
-            max_speed: 200.0,
-            preconditioner: PreconditionerKind::Auto,
+/// The multigrid preconditioners `params` asks for on `model`, whose implicit system `asm`
+/// assembles (none: block-Jacobi, which `asm` then forms during assembly).
+fn preconditioners(
+    model: &ClothModel,
+    params: &SimulationParameters,
+    asm: &mut Assembly,
+) -> Result<Preconditioners, ClothError> {
+    let mg = match (params.preconditioner, model.grid) {
+        (PreconditionerKind::BlockJacobi, _) => None,
+        (PreconditionerKind::Auto, Some((nx, ny))) if nx.min(ny) >= 16 => {
+            Some(Multigrid::new(model, &mut asm.a)?)
         }
-    }
-}
-
-impl SimulationParameters {
-    /// Checks the values, naming the first bad parameter.
-    pub fn validate(&self) -> Result<(), ClothError> {
-        let bad = |name: &str, v: f64| {
-            ClothError::Parameter(format!("simulation parameter `{name}` is invalid: {v}"))
-        };
-        if !(self.dt.is_finite() && self.dt > 0.0) {
-            return Err(bad("dt", self.dt));
+        (PreconditionerKind::Multigrid, _) => Some(Multigrid::new(model, &mut asm.a)?),
+        _ => None,
+    };
+    let amg = match params.preconditioner {
+        PreconditionerKind::Aggregation => Some(AggregationMultigrid::new(model, &asm.a)),
+        PreconditionerKind::Auto if mg.is_none() && model.particle_count() >= AGGREGATION_MIN => {
+            Some(AggregationMultigrid::new(model, &asm.a))
         }
-        if !(self.cg_tolerance.is_finite() && self.cg_tolerance > 0.0) {
-            return Err(bad("cg_tolerance", self.cg_tolerance));
-        }
-        if self.max_speed.is_nan() || self.max_speed <= 0.0 {
-            return Err(bad("max_speed", self.max_speed));
-        }
-        if let Some(g) = self.gravity.iter().find(|g| !g.is_finite()) {
-            return Err(bad("gravity", *g));
-        }
-        if self.explicit_substeps == 0 {
-            return Err(bad("explicit_substeps", 0.0));
-        }
-        Ok(())
-    }
+        _ => None,
+    };
+    // a multigrid enabled the single-precision mirrors its smoother reads
+    asm.jacobi = mg.is_none() && amg.is_none();
+    Ok((mg, amg))
 }
 
 /// A running cloth simulation.
@@ -127,16 +64,16 @@ pub struct Simulation {
     pub params: SimulationParameters,
     /// Pins and moving attachments.
     pub attachments: Vec<Attachment>,
-    /// Contact handlers consulted every step.
-    pub hooks: Vec<Box<dyn ContactHook>>,
-    /// Collision bodies, self-collision and their settings.
-    pub contact: Collisions,
     /// Statistics of every step taken.
     pub stats: Vec<StepStats>,
     /// The sewing schedule of a garment's seams, if any.
     pub sewing: Option<Sewing>,
     /// Steps whose CG solve did not reach the tolerance.
     pub unconverged_steps: u64,
+    /// Share of `params.gravity` acting (a garment's sewing turns it down while it sews).
+    gravity_share: f64,
+    /// Stages of every step beside the cloth's forces (contact), in the order added.
+    stages: Vec<Box<dyn StepStage>>,
     filter: Filter,
     z: Vec<Vec3>,
     dv: Vec<Vec3>,
@@ -158,38 +95,18 @@ impl Simulation {
         let n = model.particle_count();
         let mut asm = Assembly::new(&model);
         let state = ClothState::at_rest(model.mesh.positions.clone());
-        let mg = match (params.preconditioner, model.grid) {
-            (PreconditionerKind::BlockJacobi, _) => None,
-            (PreconditionerKind::Auto, Some((nx, ny))) if nx.min(ny) >= 16 => {
-                Some(Multigrid::new(&model, &mut asm.a)?)
-            }
-            (PreconditionerKind::Multigrid, _) => Some(Multigrid::new(&model, &mut asm.a)?),
-            _ => None,
-        };
-        let amg = match params.preconditioner {
-            PreconditionerKind::Aggregation => Some(AggregationMultigrid::new(&model, &asm.a)),
-            PreconditionerKind::Auto if mg.is_none() && n >= AGGREGATION_MIN => {
-                Some(AggregationMultigrid::new(&model, &asm.a))
-            }
-            _ => None,
-        };
-        if mg.is_some() || amg.is_some() {
-            // the multigrid enabled the single-precision mirrors its smoother reads
-            asm.jacobi = false;
-        }
-        let mut contact = Collisions::default();
-        contact.set_cloth(&model.mesh.triangles, &model.mesh.positions);
+        let (mg, amg) = preconditioners(&model, &params, &mut asm)?;
         let sides = (model.choi_ko && !model.flexion_sides.is_empty())
             .then(|| BucklingSides::new(model.flexion_sides.clone(), model.choi_ko_seed));
         Ok(Simulation {
             sides,
-            contact,
             impulse: vec![Vec3::zeros(); n],
             x_step: vec![Vec3::zeros(); n],
             state,
             params,
             attachments: Vec::new(),
-            hooks: Vec::new(),
+            gravity_share: 1.0,
+            stages: Vec::new(),
             stats: Vec::new(),
             sewing: None,
             unconverged_steps: 0,
@@ -204,6 +121,16 @@ impl Simulation {
             amg,
             model,
         })
+    }
+
+    /// Gives the cloth another material law (a measured one, say) and rebuilds what was made
+    /// from the old one (the geometric multigrid's coarse cloths).
+    pub fn set_material(&mut self, law: Arc<dyn MaterialLaw>) -> Result<(), ClothError> {
+        self.model.set_law(law);
+        let (mg, amg) = preconditioners(&self.model, &self.params, &mut self.asm)?;
+        self.mg = mg;
+        self.amg = amg;
+        Ok(())
     }
 
     /// Multigrid time spent so far: (setup s, V-cycles s, V-cycle count); `None` without multigrid.
@@ -294,9 +221,32 @@ impl Simulation {
         out
     }
 
-    /// Adds a contact handler.
-    pub fn add_hook(&mut self, hook: Box<dyn ContactHook>) {
-        self.hooks.push(hook);
+    /// Adds a stage to every step: stages constrain particles in the order added and respond
+    /// in reverse order (add contact with bodies first).
+    pub fn add_stage(&mut self, stage: Box<dyn StepStage>) {
+        self.stages.push(stage);
+    }
+
+    /// The step's stages, in the order added.
+    pub fn stages(&self) -> &[Box<dyn StepStage>] {
+        &self.stages
+    }
+
+    /// The first stage of type `T`, if any.
+    pub fn stage<T: StepStage>(&self) -> Option<&T> {
+        self.stages.iter().find_map(|s| s.as_any().downcast_ref())
+    }
+
+    /// The first stage of type `T`, mutable, if any.
+    pub fn stage_mut<T: StepStage>(&mut self) -> Option<&mut T> {
+        self.stages
+            .iter_mut()
+            .find_map(|s| s.as_any_mut().downcast_mut())
+    }
+
+    /// Whether some stage reads the step's start positions and constraint impulses.
+    fn stages_use_impulses(&self) -> bool {
+        self.stages.iter().any(|s| s.uses_impulses())
     }
 
     /// Energies of the current state: (kinetic, gravitational, elastic). Reading them leaves
@@ -306,7 +256,7 @@ impl Simulation {
     pub fn energy(&mut self) -> (f64, f64, f64) {
         let inp = AssemblyInputs {
             dt: self.params.dt,
-            gravity: Vec3::from(self.params.gravity),
+            gravity: self.gravity(),
             matrix: false,
         };
         let commit = std::mem::replace(&mut self.asm.auto_commit, false);
@@ -318,8 +268,14 @@ impl Simulation {
         (k, g, elastic)
     }
 
+    /// The gravity acting now (m/s²): the parameters' times the share a garment's sewing
+    /// lets act.
+    pub fn gravity(&self) -> Vec3 {
+        Vec3::from(self.params.gravity) * self.gravity_share
+    }
+
     fn kinetic_gravity(&self) -> (f64, f64) {
-        let gr = Vec3::from(self.params.gravity);
+        let gr = self.gravity();
         let (mut k, mut g) = (0.0, 0.0);
         for i in 0..self.particle_count() {
             let m = self.model.mass[i];
@@ -331,7 +287,7 @@ impl Simulation {
 
     fn build_filter(&mut self, t_end: f64, dt: f64) {
         self.filter.clear();
-        // attachments first: the contact stage and the hooks leave fixed particles alone, so
+        // attachments first: the stages leave fixed particles alone, so
         // friction never holds back (or moves) a particle that follows its target
         for at in &self.attachments {
             let d = at.trajectory.displacement(t_end);
@@ -342,27 +298,16 @@ impl Simulation {
                 self.filter.any = true;
             }
         }
-        if self.contact.is_active() {
-            self.contact.begin_step(
+        // each stage sees the obstacles of the stages before it
+        for k in 0..self.stages.len() {
+            let (before, rest) = self.stages.split_at_mut(k);
+            rest[0].constrain(
                 &self.state.x,
                 &self.state.v,
                 t_end - dt,
                 dt,
                 &mut self.filter,
-            );
-        }
-        let obstacles = Obstacles {
-            bodies: &self.contact.bodies,
-            clearance: self.contact.settings.thickness,
-        };
-        for hook in &mut self.hooks {
-            hook.constrain(
-                &self.state.x,
-                &self.state.v,
-                self.state.time,
-                dt,
-                &mut self.filter,
-                obstacles,
+                Obstacles::of(before),
             );
         }
     }
@@ -377,23 +322,14 @@ impl Simulation {
         self.params.validate()?;
         let t_start = Instant::now();
         if let Some(sew) = &mut self.sewing {
-            self.params.gravity = sew.update(&mut self.model, self.state.time, &self.state.x);
-            self.contact.frictionless = sew.sewing_at(self.state.time);
-            if !sew.pass_through.is_empty() {
-                let zones: &[u32] = if sew.sewing_at(self.state.time) {
-                    &sew.pass_through
-                } else {
-                    &[]
-                };
-                self.contact.set_zones(zones);
+            self.gravity_share = sew.update(&mut self.model, self.state.time, &self.state.x);
+            for stage in &mut self.stages {
+                stage.follow_sewing(sew, self.state.time);
             }
         }
         if let Some(sides) = &mut self.sides {
             let attachments = &self.attachments;
-            let obstacles = Obstacles {
-                bodies: &self.contact.bodies,
-                clearance: self.contact.settings.thickness,
-            };
+            let obstacles = Obstacles::of(&self.stages);
             sides.start_arcs(
                 &mut self.state.x,
                 |i| attachments.iter().any(|a| a.particles.contains(&i)),
@@ -420,7 +356,10 @@ impl Simulation {
             sew.slow_down(self.state.time, &mut self.state.v);
             if let Some(sep) = sew.separation.as_ref() {
                 if sew.sewing_at(self.state.time) {
-                    let crossings = self.contact.self_intersections(&self.state.x);
+                    let mut crossings = Vec::new();
+                    for stage in &mut self.stages {
+                        crossings.extend(stage.crossings(&self.state.x));
+                    }
                     sep.apply(&crossings, &mut self.state.x);
                 }
             }
@@ -466,14 +405,14 @@ impl Simulation {
         let t0 = Instant::now();
         let inp = AssemblyInputs {
             dt: h,
-            gravity: Vec3::from(self.params.gravity),
+            gravity: self.gravity(),
             matrix: true,
         };
         let elastic = self
             .asm
             .assemble(&self.model, &self.state.x, &self.state.v, inp);
-        if self.contact.is_active() {
-            self.contact.add_kinetic_friction(&mut self.asm.b);
+        for stage in &mut self.stages {
+            stage.add_forces(&mut self.asm.b);
         }
         let t1 = Instant::now();
         for i in 0..self.particle_count() {
@@ -524,7 +463,7 @@ impl Simulation {
             };
         }
         let t2 = Instant::now();
-        if self.contact.is_active() {
+        if self.stages_use_impulses() {
             self.x_step.copy_from_slice(&self.state.x);
             // constraint impulses: the residual A Δv − b lies in the constrained directions
             for i in 0..self.particle_count() {
@@ -564,50 +503,41 @@ impl Simulation {
         }
     }
 
-    /// Snaps fixed particles exactly onto their targets, lets hooks correct positions, then
-    /// runs the contact stage's response (friction, push-out, self-collision) on the step of
-    /// length `h` that started at `x_step`.
+    /// Snaps fixed particles exactly onto their targets, then runs the stages' responses
+    /// (friction, push-out, self-collision), last added first, on the step of length `h` that
+    /// started at `x_step`.
     fn finish_constraints(&mut self, h: f64) {
         for i in 0..self.particle_count() {
             if let ParticleFilter::Fixed { target } = self.filter.kind[i] {
                 self.state.x[i] = target;
             }
         }
-        for hook in &mut self.hooks {
-            hook.correct(&mut self.state.x, &mut self.state.v);
-        }
-        if self.contact.is_active() {
-            self.contact.end_step(
-                &self.x_step,
-                &mut self.state.x,
-                &mut self.state.v,
-                &self.impulse,
-                &self.model.mass,
-                &self.filter,
-                h,
-            );
+        for stage in self.stages.iter_mut().rev() {
+            stage.respond(StepEnd {
+                x_start: &self.x_step,
+                x: &mut self.state.x,
+                v: &mut self.state.v,
+                impulse: &self.impulse,
+                mass: &self.model.mass,
+                filter: &self.filter,
+                dt: h,
+            });
         }
     }
 
-    /// Copies the contact stage's statistics of the last step into `st`.
+    /// Copies the stages' statistics of the last step into `st` (no body near: an infinite
+    /// distance).
     fn contact_stats(&self, st: &mut StepStats) {
-        if self.contact.is_active() {
-            let c = &self.contact.stats;
-            st.collision_ms = c.collision_ms;
-            st.contacts = c.contacts;
-            st.self_contacts = c.self_contacts;
-            st.min_distance = c.min_distance;
-            st.penetrating = c.penetrating;
-            st.intersections = c.intersections;
-        } else {
-            st.min_distance = f64::INFINITY;
+        st.min_distance = f64::INFINITY;
+        for stage in &self.stages {
+            stage.report(st);
         }
     }
 
     fn step_explicit(&mut self) -> StepStats {
         let sub = self.params.explicit_substeps.max(1);
         let h = self.params.dt / sub as f64;
-        let gravity = Vec3::from(self.params.gravity);
+        let gravity = self.gravity();
         let (kinetic, grav) = self.kinetic_gravity();
         let mut elastic0 = 0.0;
         let t0 = Instant::now();
@@ -625,7 +555,7 @@ impl Simulation {
             if k == 0 {
                 elastic0 = e;
             }
-            if self.contact.is_active() {
+            if self.stages_use_impulses() {
                 self.x_step.copy_from_slice(&self.state.x);
             }
             for i in 0..self.particle_count() {

@@ -6,6 +6,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::mesh_body::MeshBody;
+use super::proximity::Proximity;
 use super::ContactError;
 use crate::geometry::Vec3;
 
@@ -80,17 +81,6 @@ pub enum Shape {
     },
     /// A triangle mesh (closed meshes have an inside; open ones a front and a back).
     Mesh(Box<MeshBody>),
-}
-
-/// Where a point is relative to a body's surface.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Proximity {
-    /// Signed distance (m): negative inside the body.
-    pub distance: f64,
-    /// Outward unit normal of the surface at the closest point.
-    pub normal: Vec3,
-    /// Velocity of the surface at the closest point (m/s).
-    pub velocity: Vec3,
 }
 
 /// A collision body: a shape with friction and a name for messages.

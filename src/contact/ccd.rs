@@ -345,24 +345,8 @@ pub fn vertex_face_ccd(x: [Vec3; 4], d: [Vec3; 4], thickness: f64) -> Option<Ccd
         })
     };
 
-    if coeffs.iter().all(|ci| ci.abs() <= ftol) {
-        let mut cand = [0.0; 32];
-        let pairs = [[0, 1, 2], [0, 2, 3], [0, 3, 1]];
-        let n = coplanar_candidates(&x, &d, &pairs, &mut cand);
-        return cand[..n].iter().find_map(|&t| test(t, 0.0));
-    }
-
-    let mut roots = [0.0; 8];
-    let n = roots_in_unit(&coeffs, ftol, &mut roots);
-    let mut prev = 0.0;
-    for &r in &roots[..n] {
-        let side = side_before(&coeffs, prev, r, ftol);
-        if let Some(hit) = test(r, side) {
-            return Some(hit);
-        }
-        prev = r;
-    }
-    None
+    let pairs = [[0, 1, 2], [0, 2, 3], [0, 3, 1]];
+    earliest_hit(&x, &d, &coeffs, ftol, &pairs, test)
 }
 
 /// Edge–edge continuous collision test.
@@ -403,18 +387,33 @@ pub fn edge_edge_ccd(x: [Vec3; 4], d: [Vec3; 4], thickness: f64) -> Option<CcdHi
         })
     };
 
+    let pairs = [[0, 2, 3], [1, 2, 3], [2, 0, 1], [3, 0, 1]];
+    earliest_hit(&x, &d, &coeffs, ftol, &pairs, test)
+}
+
+/// The first hit `test(t, side)` finds at the coplanarity times of four moving points: the
+/// roots in `[0, 1]` of their cubic `coeffs` (tolerance `ftol`), each with the side the points
+/// came from, or, when the cubic vanishes (coplanar throughout), the candidate times of the
+/// point–segment `pairs` (side 0).
+fn earliest_hit(
+    x: &[Vec3; 4],
+    d: &[Vec3; 4],
+    coeffs: &[f64; 4],
+    ftol: f64,
+    pairs: &[[usize; 3]],
+    test: impl Fn(f64, f64) -> Option<CcdHit>,
+) -> Option<CcdHit> {
     if coeffs.iter().all(|ci| ci.abs() <= ftol) {
         let mut cand = [0.0; 32];
-        let pairs = [[0, 2, 3], [1, 2, 3], [2, 0, 1], [3, 0, 1]];
-        let n = coplanar_candidates(&x, &d, &pairs, &mut cand);
+        let n = coplanar_candidates(x, d, pairs, &mut cand);
         return cand[..n].iter().find_map(|&t| test(t, 0.0));
     }
 
     let mut roots = [0.0; 8];
-    let n = roots_in_unit(&coeffs, ftol, &mut roots);
+    let n = roots_in_unit(coeffs, ftol, &mut roots);
     let mut prev = 0.0;
     for &r in &roots[..n] {
-        let side = side_before(&coeffs, prev, r, ftol);
+        let side = side_before(coeffs, prev, r, ftol);
         if let Some(hit) = test(r, side) {
             return Some(hit);
         }

@@ -10,7 +10,7 @@ use parry3d_f64::math::Vector as PVec;
 use parry3d_f64::query::PointQueryWithLocation;
 use parry3d_f64::shape::{TriMesh as ParryMesh, TriMeshFlags, TrianglePointLocation};
 
-use super::body::Proximity;
+use super::proximity::Proximity;
 use super::ContactError;
 use crate::geometry::Vec3;
 

@@ -15,7 +15,7 @@ use crate::body::Mannequin;
 use crate::cloth::{
     ClothModel, FabricParameters, Separation, Sewing, Simulation, SimulationParameters,
 };
-use crate::contact::{Body, ContactSettings, MeshBody};
+use crate::contact::{Body, ContactSettings, MeshBody, SimulationContact};
 use crate::geometry::Vec3;
 
 /// Settings of [`dress`].
@@ -161,16 +161,17 @@ pub fn dress(
         &x,
         (params.seam_stiffness, params.seam_max_force),
         params.sewing_speed,
-        sim_params.gravity,
     );
     if params.seam_hinges {
         sewing.add_hinges(&mut model, seam_hinges(&garment));
     }
     let mut sim = Simulation::new(model, sim_params).map_err(cloth_err)?;
-    sim.contact.settings = params.contact;
-    sim.contact.bodies.push(Body::mesh(skin));
-    sim.contact.set_welds(x.len(), &pairs);
-    let crossings = sim.contact.self_intersections(&sim.state.x);
+    let contact = sim.add_contact();
+    contact.settings = params.contact;
+    contact.bodies.push(Body::mesh(skin));
+    contact.set_welds(x.len(), &pairs);
+    let x0 = sim.state.x.clone();
+    let crossings = sim.contact_mut().self_intersections(&x0);
     let crossed = crossed_centre_pieces(pattern, &garment, &crossings);
     keep_to_sides(
         &garment,
@@ -184,7 +185,7 @@ pub fn dress(
     // where pre-positioning left two pieces of a centre seam crossing each other, or a piece
     // through itself (the crotch of trousers), they may pass through each other near there
     // while sewn
-    let crossings = sim.contact.self_intersections(&x);
+    let crossings = sim.contact_mut().self_intersections(&x);
     sewing.pass_through = pass_through_zones(pattern, &garment, &crossings, PASS_THROUGH);
     sewing.separation = separation(&garment, &sewing.pass_through, &x, &frame);
     let report = DressReport {
@@ -313,13 +314,14 @@ fn untangle_knots(garment: &GarmentMesh, sim: &mut Simulation) -> usize {
     let mut marked = vec![false; n];
     let mut left = 0;
     for round in 0..=KNOT_ROUNDS {
-        let x = &mut sim.state.x;
+        let now = sim.state.x.clone();
         let knots: Vec<([u32; 2], [u32; 3])> = sim
-            .contact
-            .self_intersections(x)
+            .contact_mut()
+            .self_intersections(&now)
             .into_iter()
             .filter(|(e, t)| piece[e[0] as usize] == piece[t[0] as usize])
             .collect();
+        let x = &mut sim.state.x;
         left = knots.len();
         if knots.is_empty() || round == KNOT_ROUNDS {
             break;

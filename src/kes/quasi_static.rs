@@ -4,9 +4,9 @@
 //! term only regularises, and a backtracking line search. The virtual rigs (Kawabata tests,
 //! the cantilever, the compressed strip) read their forces from it.
 
-use crate::cloth::assembly::{Assembly, AssemblyInputs};
 use crate::cloth::constraints::{Filter, ParticleFilter};
-use crate::cloth::pcg::{PcgWorkspace, Preconditioner};
+use crate::cloth::solver::assembly::{Assembly, AssemblyInputs};
+use crate::cloth::solver::pcg::{PcgWorkspace, Preconditioner};
 use crate::cloth::{ClothError, ClothModel};
 use crate::geometry::Vec3;
 

@@ -11,19 +11,22 @@ use super::{register, SimHandle};
 use crate::body::RetargetOptions;
 use crate::cloth::ClothError;
 use crate::contact::character::mannequin_body;
-use crate::contact::{Body, ContactError, ContactSettings, FrictionCoefficients, MeshBody};
+use crate::contact::{
+    Body, ContactError, ContactSettings, FrictionCoefficients, MeshBody, SimulationContact,
+};
 use crate::geometry::files::data_path;
 use crate::geometry::{read_obj_surface, Vec3};
 
 fn contact_err(e: ContactError) -> Box<rhai::EvalAltResult> {
-    ClothError::Contact(e).into()
+    ClothError::from(e).into()
 }
 
 fn add_body(h: &SimHandle, body: Result<Body, ContactError>) -> RResult<INT> {
     let body = body.map_err(contact_err)?;
     let mut s = h.get_mut()?;
-    s.contact.bodies.push(body);
-    Ok((s.contact.bodies.len() - 1) as INT)
+    let contact = s.contact_mut();
+    contact.bodies.push(body);
+    Ok((contact.bodies.len() - 1) as INT)
 }
 
 fn v3(d: &Dynamic, what: &str) -> RResult<Vec3> {
@@ -94,8 +97,9 @@ pub fn register(engine: &mut Engine) {
             let f = FrictionCoefficients { static_: finite(&s, "static")?, kinetic: finite(&k, "kinetic")? };
             f.validate("body friction").map_err(contact_err)?;
             let mut sim = h.get_mut()?;
-            let n = sim.contact.bodies.len();
-            let body = sim.contact.bodies.get_mut(index(b, "body")?)
+            let bodies = &mut sim.contact_mut().bodies;
+            let n = bodies.len();
+            let body = bodies.get_mut(index(b, "body")?)
                 .ok_or_else(|| rt_err(format!("body {b} does not exist ({n} bodies)")))?;
             body.friction = f;
             Ok(())
@@ -104,9 +108,9 @@ pub fn register(engine: &mut Engine) {
         "Changes contact settings from a map: thickness (m, cloth–body distance), friction of\nthe fabric (mu_static, mu_kinetic), self_collision (bool), self_thickness (m), self_friction,\nmax_push_speed (m/s), count_intersections (bool). Values are checked.",
         |h: &mut SimHandle, m: Map| -> RResult<()> {
             let mut sim = h.get_mut()?;
-            let s: ContactSettings = update_from_map(&sim.contact.settings, &m, "contact")?;
+            let s: ContactSettings = update_from_map(&sim.contact().settings, &m, "contact")?;
             s.validate().map_err(contact_err)?;
-            sim.contact.settings = s;
+            sim.contact_mut().settings = s;
             Ok(())
         });
     register!(
@@ -114,7 +118,7 @@ pub fn register(engine: &mut Engine) {
         "contact_settings",
         ["sim: Simulation", "Map"],
         "The contact settings as a map (see `set_contact`).",
-        |h: &mut SimHandle| -> RResult<Dynamic> { Ok(to_map(&h.get()?.contact.settings)) }
+        |h: &mut SimHandle| -> RResult<Dynamic> { Ok(to_map(&h.get()?.contact().settings)) }
     );
     register!(engine, "pin_to_body", ["sim: Simulation", "particles: Array", "body: int"],
         "Makes particles follow a mesh body (e.g. a waistband on the mannequin): each keeps its\npresent offset from the body vertex nearest to it (in the body's rest pose), turning with it.",
@@ -122,7 +126,7 @@ pub fn register(engine: &mut Engine) {
             let p = indices(&p, "particle")?;
             let mut sim = h.get_mut()?;
             let x = sim.state.x.clone();
-            sim.contact.pin_to_body(index(b, "body")?, &p, &x, None).map_err(contact_err)
+            sim.contact_mut().pin_to_body(index(b, "body")?, &p, &x, None).map_err(contact_err)
         });
     register!(engine, "pin_to_body", ["sim: Simulation", "particles: Array", "body: int", "snap: Map"],
         "As `pin_to_body`, and draws the particles onto the body: `#{gap: 0.006, from: 0.0, to: 0.5}`\neases each offset, between simulation times `from` and `to` (s), to `gap` m along the body\nnormal (a waistband gathered onto the waist).",
@@ -136,14 +140,14 @@ pub fn register(engine: &mut Engine) {
             let p = indices(&p, "particle")?;
             let mut sim = h.get_mut()?;
             let x = sim.state.x.clone();
-            sim.contact.pin_to_body(index(b, "body")?, &p, &x, Some(snap)).map_err(contact_err)
+            sim.contact_mut().pin_to_body(index(b, "body")?, &p, &x, Some(snap)).map_err(contact_err)
         });
     register!(engine, "save_body_obj", ["sim: Simulation", "body: int", "path: String"],
         "Writes a body's current surface (a mesh body's triangles, or a tessellation of a sphere,\nbox or plane around the cloth) as an OBJ file.",
         |h: &mut SimHandle, b: INT, path: &str| -> RResult<()> {
             let sim = h.get()?;
-            let n = sim.contact.bodies.len();
-            let body = sim.contact.bodies.get(index(b, "body")?)
+            let n = sim.contact().bodies.len();
+            let body = sim.contact().bodies.get(index(b, "body")?)
                 .ok_or_else(|| rt_err(format!("body {b} does not exist ({n} bodies)")))?;
             let (lo, hi) = crate::geometry::mesh::bounds(&sim.state.x);
             let (p, t) = crate::contact::tessellate::body_mesh(body, &lo, &hi);
@@ -158,10 +162,10 @@ pub fn register(engine: &mut Engine) {
         |h: &mut SimHandle| -> RResult<Map> {
             let mut sim = h.get_mut()?;
             let x = sim.state.x.clone();
-            let r = sim.contact.report(&x);
-            let st = sim.contact.stats;
+            let r = sim.contact_mut().report(&x);
+            let st = sim.contact().stats;
             let mut m = Map::new();
-            m.insert("bodies".into(), Dynamic::from_int(sim.contact.bodies.len() as INT));
+            m.insert("bodies".into(), Dynamic::from_int(sim.contact().bodies.len() as INT));
             m.insert("min_distance".into(), Dynamic::from_float(r.min_distance));
             m.insert("penetrating".into(), Dynamic::from_int(r.penetrating as INT));
             m.insert("intersections".into(), Dynamic::from_int(r.intersections as INT));
@@ -179,7 +183,7 @@ pub fn register(engine: &mut Engine) {
             let mut sim = h.get_mut()?;
             let x = sim.state.x.clone();
             let ints = |v: &[u32]| v.iter().map(|&i| Dynamic::from_int(i as INT)).collect::<Array>();
-            Ok(sim.contact.self_intersections(&x).iter().map(|(e, t)| {
+            Ok(sim.contact_mut().self_intersections(&x).iter().map(|(e, t)| {
                 let mut m = Map::new();
                 m.insert("edge".into(), Dynamic::from_array(ints(e)));
                 m.insert("triangle".into(), Dynamic::from_array(ints(t)));

@@ -74,7 +74,7 @@ fn dress_on_mannequin(
     let man = Mannequin::load_makehuman(&dir).map_err(|e| rt_err(e.to_string()))?;
     let mut d = dress(pattern, fabric, &man, &params, sp).map_err(perr)?;
     if let Some(law) = law {
-        d.simulation.model.set_law(law);
+        d.simulation.set_material(law)?;
     }
     Ok(SimHandle::new(d.simulation))
 }

@@ -7,7 +7,7 @@ use rhai::{Array, Dynamic, Engine, Map, INT};
 
 use super::convert::{finite, index, non_negative, rt_err, RResult};
 use super::{register, SimHandle};
-use crate::cloth::wrinkles::{compressed_springs, energy_parts, wrinkles_along};
+use crate::cloth::buckling::wrinkles::{compressed_springs, energy_parts, wrinkles_along};
 use crate::geometry::Vec3;
 use crate::render::plot::{write_plot_pair, write_series_csv, PlotSpec, Series, SeriesStyle};
 

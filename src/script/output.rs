@@ -9,6 +9,7 @@ use super::convert::{arr3, count, finite, rt_err, to_map, RResult};
 use super::{register, SimHandle};
 use crate::cloth::{stats, Simulation};
 use crate::contact::tessellate::body_mesh;
+use crate::contact::SimulationContact;
 use crate::geometry::LookAtCamera;
 use crate::geometry::{mesh::bounds, write_glb, write_obj};
 use crate::render::{render_png, RenderMesh};
@@ -72,7 +73,7 @@ fn render(sim: &Simulation, path: &str, cam: &LookAtCamera) -> RResult<()> {
     parent_dir(path)?;
     let (lo, hi) = bounds(&sim.state.x);
     let bodies: Vec<_> = sim
-        .contact
+        .contact()
         .bodies
         .iter()
         .map(|b| body_mesh(b, &lo, &hi))

@@ -13,7 +13,8 @@ use super::convert::{
     count, finite, get_field, indices, rt_err, to_map, update_field, update_from_map, vec3, RResult,
 };
 use super::{getter, register, ClothHandle};
-use crate::cloth::{Floor, Simulation, SimulationParameters, Trajectory};
+use crate::cloth::{Simulation, SimulationParameters, Trajectory};
+use crate::contact::{Floor, SimulationContact};
 
 /// A simulation as a script handle: every copy refers to the same simulation.
 #[derive(Debug, Clone)]
@@ -43,9 +44,9 @@ impl fmt::Display for SimHandle {
         match self.0.try_borrow() {
             Ok(s) => write!(
                 f,
-                "Simulation({} particles, t = {:.4} s, {} steps, dt = {} s, {:?}, {} attachments, {} contact hooks)",
+                "Simulation({} particles, t = {:.4} s, {} steps, dt = {} s, {:?}, {} attachments, {} step stages)",
                 s.particle_count(), s.state.time, s.state.step, s.params.dt, s.params.integrator,
-                s.attachments.len(), s.hooks.len()
+                s.attachments.len(), s.stages().len()
             ),
             Err(_) => f.write_str("Simulation(busy)"),
         }
@@ -174,7 +175,9 @@ pub fn register(engine: &mut Engine) {
     engine.register_type_with_name::<SimHandle>("Simulation");
     let new_sim = |c: &ClothHandle, m: &Map| -> RResult<SimHandle> {
         let params = update_from_map(&SimulationParameters::default(), m, "simulation")?;
-        Ok(SimHandle::new(Simulation::new((*c.0).clone(), params)?))
+        let mut sim = Simulation::new((*c.0).clone(), params)?;
+        sim.add_contact();
+        Ok(SimHandle::new(sim))
     };
     register!(engine, "simulation", ["cloth: Cloth", "Simulation"],
         "A simulation of `cloth` at rest, with default settings (dt 1/120 s, implicit, gravity −9.81 z).",
@@ -258,7 +261,7 @@ pub fn register(engine: &mut Engine) {
                 height: finite(&z, "height")?,
                 thickness: finite(&t, "thickness")?,
             };
-            h.get_mut()?.add_hook(Box::new(floor));
+            h.get_mut()?.add_stage(Box::new(floor));
             Ok(())
         }
     );
@@ -272,7 +275,7 @@ most compressed springs' particles are sent to where their springs regain their 
 compression that triggers a release, how long a particle is held, the seed of the random
 up/down choice on a flat cloth (one side of the cloth per step for all its ties).",
         |h: &mut SimHandle, m: Map| -> RResult<()> {
-            use crate::cloth::compression_release::{CompressionRelease, ReleaseOptions};
+            use crate::cloth::buckling::compression_release::{CompressionRelease, ReleaseOptions};
             const KEYS: [&str; 3] = ["strain", "hold_steps", "seed"];
             if let Some(k) = m.keys().find(|k| !KEYS.contains(&k.as_str())) {
                 return Err(rt_err(format!(
@@ -292,7 +295,7 @@ up/down choice on a flat cloth (one side of the cloth per step for all its ties)
             }
             let mut sim = h.get_mut()?;
             let cr = CompressionRelease::new(&sim.model, o);
-            sim.add_hook(Box::new(cr));
+            sim.add_stage(Box::new(cr));
             Ok(())
         }
     );

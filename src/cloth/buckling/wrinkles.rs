@@ -2,8 +2,8 @@
 //! buckling model gets stuck compressed instead of wrinkling), and the wrinkles along a line of
 //! a grid cloth (half-waves, wavelength, amplitude).
 
-use super::elements::SpringKind;
-use super::model::ClothModel;
+use crate::cloth::elements::SpringKind;
+use crate::cloth::model::ClothModel;
 use crate::geometry::Vec3;
 
 /// Compressed stretch springs.
@@ -176,8 +176,8 @@ mod tests {
 
     #[test]
     fn energy_parts_add_up_to_the_assembled_energy() {
-        use crate::cloth::assembly::{Assembly, AssemblyInputs};
-        use crate::cloth::material::FabricParameters;
+        use crate::cloth::elements::material::FabricParameters;
+        use crate::cloth::solver::assembly::{Assembly, AssemblyInputs};
         let fabric = FabricParameters::default();
         let mut m = ClothModel::grid(0.3, 0.2, 7, 5, fabric).unwrap();
         m.perturb(Vec3::new(0.3, -0.2, 1.0), 0.02, 7);

@@ -7,11 +7,12 @@
 
 use super::assembly::{Assembly, AssemblyInputs};
 use super::bcsr::{Bcsr3, Sym3f};
-use super::constraints::{Filter, ParticleFilter};
 use super::line_solver::{weft_order, LineDir, LineSolver};
-use super::model::ClothModel;
 use super::parallel::{for_each_mut, PAR_MIN};
-use super::ClothError;
+use super::vcycle::{self, Hierarchy};
+use crate::cloth::constraints::{Filter, ParticleFilter};
+use crate::cloth::model::ClothModel;
+use crate::cloth::ClothError;
 use crate::geometry::Vec3;
 
 /// Coarsest grid size (particles per side) at which the V-cycle stops coarsening.
@@ -313,76 +314,29 @@ impl Multigrid {
 
     /// Applies one V-cycle to residual `r` (finest level, matrix `a`), writing `s ≈ A⁻¹ r`.
     pub fn apply(&mut self, a: &Bcsr3, r: &[Vec3], s: &mut [Vec3]) {
-        let t0 = std::time::Instant::now();
-        self.levels[0].r.copy_from_slice(r);
-        self.vcycle(0, a);
-        s.copy_from_slice(&self.levels[0].e);
-        self.timing.1 += t0.elapsed().as_secs_f64();
-        self.timing.2 += 1;
+        vcycle::apply(self, a, r, s);
+    }
+}
+
+impl Hierarchy for Multigrid {
+    fn depth(&self) -> usize {
+        self.levels.len()
     }
 
-    fn vcycle(&mut self, l: usize, a0: &Bcsr3) {
-        if l + 1 == self.levels.len() {
-            self.coarsest(l, a0);
-            return;
-        }
-        {
-            let lv = &mut self.levels[l];
-            let a = operator(&lv.asm, a0);
-            let pen = lv.penalized.then_some(&lv.pen[..]);
-            lv.e.fill(Vec3::zeros());
-            // pre-smoothing: warp lines, then weft lines, colours forward; the weft sweep,
-            // the residual and the transfers work in the weft numbering
-            lv.lines.sweep(
-                a,
-                LineDir::Warp,
-                &lv.r,
-                &mut lv.e,
-                &lv.fixed,
-                pen,
-                FORWARD,
-                true,
-            );
-            lv.lines.enter_weft(&lv.r, &lv.e);
-            lv.lines.sweep_weft(a, lv.penalized, FORWARD, false);
-            lv.lines
-                .residual_weft(a, lv.penalized, FORWARD[2], &mut lv.d);
-        }
-        {
-            let (fine, coarse) = self.levels.split_at_mut(l + 1);
-            let (f, c) = (&fine[l], &mut coarse[0]);
-            f.to_fine
-                .as_ref()
-                .expect("transfer")
-                .restrict(&f.d, &mut c.r, &c.fixed);
-        }
-        self.vcycle(l + 1, a0);
-        let (fine, coarse) = self.levels.split_at_mut(l + 1);
-        let (lv, c) = (&mut fine[l], &coarse[0]);
-        let (e_weft, fixed_weft) = lv.lines.weft_correction();
-        lv.to_fine
-            .as_ref()
-            .expect("transfer")
-            .prolong_add(&c.e, e_weft, fixed_weft);
-        let a = operator(&lv.asm, a0);
-        // post-smoothing, the adjoint of the pre-smoothing: weft then warp, colours backward
-        lv.lines.sweep_weft(a, lv.penalized, BACKWARD, false);
-        lv.lines.leave_weft(&mut lv.e);
-        let pen = lv.penalized.then_some(&lv.pen[..]);
-        lv.lines.sweep(
-            a,
-            LineDir::Warp,
-            &lv.r,
-            &mut lv.e,
-            &lv.fixed,
-            pen,
-            BACKWARD,
-            false,
-        );
+    fn finest_rhs(&mut self) -> &mut [Vec3] {
+        &mut self.levels[0].r
+    }
+
+    fn finest_correction(&self) -> &[Vec3] {
+        &self.levels[0].e
+    }
+
+    fn cycle_timing(&mut self) -> (&mut f64, &mut u64) {
+        (&mut self.timing.1, &mut self.timing.2)
     }
 
     /// The coarsest level of a V-cycle: symmetric alternating line sweeps only.
-    fn coarsest(&mut self, l: usize, a0: &Bcsr3) {
+    fn solve_coarsest(&mut self, l: usize, a0: &Bcsr3) {
         let lv = &mut self.levels[l];
         let a = operator(&lv.asm, a0);
         let pen = lv.penalized.then_some(&lv.pen[..]);
@@ -401,6 +355,67 @@ impl Multigrid {
             lv.lines
                 .sweep(a, LineDir::Warp, r, e, &lv.fixed, pen, BACKWARD, false);
         }
+    }
+
+    /// Warp lines, then weft lines, colours forward; the weft sweep, the residual and the
+    /// transfers work in the weft numbering.
+    fn pre_smooth(&mut self, l: usize, a0: &Bcsr3) {
+        let lv = &mut self.levels[l];
+        let a = operator(&lv.asm, a0);
+        let pen = lv.penalized.then_some(&lv.pen[..]);
+        lv.e.fill(Vec3::zeros());
+        lv.lines.sweep(
+            a,
+            LineDir::Warp,
+            &lv.r,
+            &mut lv.e,
+            &lv.fixed,
+            pen,
+            FORWARD,
+            true,
+        );
+        lv.lines.enter_weft(&lv.r, &lv.e);
+        lv.lines.sweep_weft(a, lv.penalized, FORWARD, false);
+        lv.lines
+            .residual_weft(a, lv.penalized, FORWARD[2], &mut lv.d);
+    }
+
+    fn restrict(&mut self, l: usize) {
+        let (fine, coarse) = self.levels.split_at_mut(l + 1);
+        let (f, c) = (&fine[l], &mut coarse[0]);
+        f.to_fine
+            .as_ref()
+            .expect("transfer")
+            .restrict(&f.d, &mut c.r, &c.fixed);
+    }
+
+    fn prolong(&mut self, l: usize) {
+        let (fine, coarse) = self.levels.split_at_mut(l + 1);
+        let (lv, c) = (&mut fine[l], &coarse[0]);
+        let (e_weft, fixed_weft) = lv.lines.weft_correction();
+        lv.to_fine
+            .as_ref()
+            .expect("transfer")
+            .prolong_add(&c.e, e_weft, fixed_weft);
+    }
+
+    /// Weft then warp, colours backward.
+    fn post_smooth(&mut self, l: usize, a0: &Bcsr3) {
+        let lv = &mut self.levels[l];
+        let a = operator(&lv.asm, a0);
+        lv.lines.sweep_weft(a, lv.penalized, BACKWARD, false);
+        lv.lines.leave_weft(&mut lv.e);
+        let pen = lv.penalized.then_some(&lv.pen[..]);
+        lv.lines.sweep(
+            a,
+            LineDir::Warp,
+            &lv.r,
+            &mut lv.e,
+            &lv.fixed,
+            pen,
+            BACKWARD,
+            false,
+        );
     }
 }
 

@@ -15,9 +15,10 @@ use rayon::prelude::*;
 
 use super::aggregation::{aggregate, Graph};
 use super::bcsr::{Bcsr3, Mat3f};
-use super::constraints::{Filter, ParticleFilter};
-use super::model::ClothModel;
 use super::parallel::{for_each_mut, SyncPtr, PAR_MIN};
+use super::vcycle::{self, Hierarchy};
+use crate::cloth::constraints::{Filter, ParticleFilter};
+use crate::cloth::model::ClothModel;
 use crate::geometry::{Mat3, Vec3};
 
 /// Coarsening stops at this many particles or fewer (the coarsest level is factorised).
@@ -239,53 +240,69 @@ impl AggregationMultigrid {
 
     /// Applies one V-cycle to residual `r` (finest level, matrix `a`), writing `s ≈ A⁻¹ r`.
     pub fn apply(&mut self, a: &Bcsr3, r: &[Vec3], s: &mut [Vec3]) {
-        let t0 = std::time::Instant::now();
-        self.levels[0].r.copy_from_slice(r);
-        self.vcycle(0, a);
-        s.copy_from_slice(&self.levels[0].e);
-        self.timing.1 += t0.elapsed().as_secs_f64();
-        self.timing.2 += 1;
+        vcycle::apply(self, a, r, s);
+    }
+}
+
+impl Hierarchy for AggregationMultigrid {
+    fn depth(&self) -> usize {
+        self.levels.len()
     }
 
-    fn vcycle(&mut self, l: usize, a0: &Bcsr3) {
-        if l + 1 == self.levels.len() {
-            let lv = &mut self.levels[l];
-            if self.coarsest.ok {
-                self.coarsest.solve(&lv.r, &mut lv.e, &lv.fixed);
-            } else {
-                lv.e.fill(Vec3::zeros());
-                lv.with_operator(a0, |lv, a| {
-                    for _ in 0..4 {
-                        lv.sweep(a, true);
-                        lv.sweep(a, false);
-                    }
-                });
-            }
-            return;
-        }
-        {
-            let lv = &mut self.levels[l];
+    fn finest_rhs(&mut self) -> &mut [Vec3] {
+        &mut self.levels[0].r
+    }
+
+    fn finest_correction(&self) -> &[Vec3] {
+        &self.levels[0].e
+    }
+
+    fn cycle_timing(&mut self) -> (&mut f64, &mut u64) {
+        (&mut self.timing.1, &mut self.timing.2)
+    }
+
+    /// The dense Cholesky factor, or symmetric block Gauss–Seidel sweeps where the level is
+    /// not positive definite.
+    fn solve_coarsest(&mut self, l: usize, a0: &Bcsr3) {
+        let lv = &mut self.levels[l];
+        if self.coarsest.ok {
+            self.coarsest.solve(&lv.r, &mut lv.e, &lv.fixed);
+        } else {
             lv.e.fill(Vec3::zeros());
             lv.with_operator(a0, |lv, a| {
-                lv.sweep(a, true);
-                lv.residual(a);
-            });
-        }
-        {
-            let (fine, coarse) = self.levels.split_at_mut(l + 1);
-            let (f, c) = (&fine[l], &mut coarse[0]);
-            let (cfixed, rt, ptr, d) = (&c.fixed, &f.rt, &f.rt_ptr, &f.d);
-            let par = c.r.len() >= PAR_MIN;
-            for_each_mut(&mut c.r, par, |ci, out| {
-                *out = Vec3::zeros();
-                if !cfixed[ci] {
-                    for &(i, w) in &rt[ptr[ci]..ptr[ci + 1]] {
-                        *out += d[i as usize] * w;
-                    }
+                for _ in 0..4 {
+                    lv.sweep(a, true);
+                    lv.sweep(a, false);
                 }
             });
         }
-        self.vcycle(l + 1, a0);
+    }
+
+    fn pre_smooth(&mut self, l: usize, a0: &Bcsr3) {
+        let lv = &mut self.levels[l];
+        lv.e.fill(Vec3::zeros());
+        lv.with_operator(a0, |lv, a| {
+            lv.sweep(a, true);
+            lv.residual(a);
+        });
+    }
+
+    fn restrict(&mut self, l: usize) {
+        let (fine, coarse) = self.levels.split_at_mut(l + 1);
+        let (f, c) = (&fine[l], &mut coarse[0]);
+        let (cfixed, rt, ptr, d) = (&c.fixed, &f.rt, &f.rt_ptr, &f.d);
+        let par = c.r.len() >= PAR_MIN;
+        for_each_mut(&mut c.r, par, |ci, out| {
+            *out = Vec3::zeros();
+            if !cfixed[ci] {
+                for &(i, w) in &rt[ptr[ci]..ptr[ci + 1]] {
+                    *out += d[i as usize] * w;
+                }
+            }
+        });
+    }
+
+    fn prolong(&mut self, l: usize) {
         let (fine, coarse) = self.levels.split_at_mut(l + 1);
         let (f, c) = (&mut fine[l], &coarse[0]);
         let (p, ptr, fixed, proj, projected) = (&f.p, &f.p_ptr, &f.fixed, &f.proj, &f.projected);
@@ -299,7 +316,10 @@ impl AggregationMultigrid {
                 *e += if projected[i] { proj[i] * de } else { de };
             }
         });
-        f.with_operator(a0, |f, a| f.sweep(a, false));
+    }
+
+    fn post_smooth(&mut self, l: usize, a0: &Bcsr3) {
+        self.levels[l].with_operator(a0, |f, a| f.sweep(a, false));
     }
 }
 

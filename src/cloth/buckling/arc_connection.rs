@@ -14,13 +14,13 @@
 //! Here the arc is as long as the fabric: the rest length L while the path from a through
 //! the middle to c is no longer than at rest, L · path/path₀ once it is longer. The
 //! connection then answers at the virtual length l = |c − a| · min(1, path₀/path) with
-//! the force of [`super::elements::SpringKind::Flexion`]; its gradient involves the middle
+//! the force of [`crate::cloth::elements::SpringKind::Flexion`]; its gradient involves the middle
 //! particles (on a grid the particle between a and c, on a mesh the shared edge, through its
 //! midpoint), which take the reaction: bending, not a push on the membrane.
 
 use super::choi_ko;
-use super::elements::{blend, Spring, SpringKind};
-use super::material::MaterialLaw;
+use crate::cloth::elements::material::MaterialLaw;
+use crate::cloth::elements::{blend, Spring, SpringKind};
 use crate::geometry::{Mat3, Vec3};
 
 /// A Choi–Ko connection between `nodes[0]` and `nodes[1]` through the midpoint of

@@ -6,9 +6,9 @@ use rayon::prelude::*;
 
 use super::amg::AggregationMultigrid;
 use super::bcsr::Bcsr3;
-use super::constraints::Filter;
 use super::multigrid::Multigrid;
 use super::parallel::{chunks, ordered_sum, CHUNK};
+use crate::cloth::constraints::Filter;
 use crate::geometry::{Mat3, Vec3};
 
 /// Scratch vectors of the solver, allocated once per topology.

@@ -1,10 +1,14 @@
 //! Force elements of a cloth model: springs (stretch and shear), bending lines (three
 //! consecutive particles along a warp or weft line of a grid) and dihedral hinges (two
 //! triangles sharing an edge, for any triangle mesh). Each element evaluates its energy,
-//! forces and stiffness blocks from a `MaterialLaw`.
+//! forces and stiffness blocks from a `MaterialLaw` ([`material`]; measured laws in
+//! [`measured`]).
 
-use super::choi_ko;
-use super::material::{Direction, Friction, MaterialLaw};
+pub mod material;
+pub mod measured;
+
+use self::material::{Direction, Friction, MaterialLaw};
+use super::buckling::choi_ko;
 use crate::geometry::{Mat3, Vec3};
 
 /// What a spring resists.
@@ -21,7 +25,7 @@ pub enum SpringKind {
     /// Choi–Ko's interlaced connection between particles two apart along a grid line, or
     /// between the opposite vertices of two triangles sharing an edge: slack in tension (the
     /// stretch springs carry it), and compressed it takes the buckling force of an arc of its
-    /// rest length bent by the bending law (see [`super::choi_ko`]), capped near the onset by
+    /// rest length bent by the bending law (see [`super::buckling::choi_ko`]), capped near the onset by
     /// the stretch law's compression so the force is continuous at the rest length.
     Flexion {
         /// Weight of the warp laws (cos² of the angle between the connection and the warp).

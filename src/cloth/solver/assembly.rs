@@ -11,10 +11,10 @@
 use rayon::prelude::*;
 
 use super::bcsr::{Bcsr3, Sym3, Sym3f, SYM_ROW_MAX};
-use super::elements::{BendLine, SpringKind};
-use super::material::Direction;
-use super::model::ClothModel;
-use super::parallel::{chunks, ordered_sum, stream_copy, stream_fence, SyncPtr, CHUNK};
+use super::contribution::{contribute_all, Pass};
+use super::parallel::{chunks, stream_copy, stream_fence, SyncPtr, CHUNK};
+use crate::cloth::elements::material::Direction;
+use crate::cloth::model::ClothModel;
 use crate::geometry::{Mat3, Vec3};
 
 /// One matrix contribution: `values[slot] += scale · block src`, the scale kept apart (see
@@ -240,6 +240,9 @@ impl Assembly {
         energy
     }
 
+    /// Evaluates every element, kind by kind, into its slots of the flat buffers; returns the
+    /// elastic energy (each kind's sum, in the order springs, shear cells, bending lines,
+    /// hinges, arcs).
     fn element_pass(
         &mut self,
         model: &ClothModel,
@@ -255,16 +258,28 @@ impl Assembly {
         } else {
             (1.0, 0.0)
         };
-        let (beta_s, beta_b) = (fab.stretch_damping, fab.bend_damping);
-        let ns = model.springs.len();
-        let nq = model.shear_quads.len();
-        let nb = model.bend_lines.len();
-        let nsc = chunks(ns, CHUNK);
-        let nqc = chunks(nq, CHUNK);
-        let nbc = chunks(nb, CHUNK);
+        let friction = !self.fric_spring.is_empty();
+        let p = Pass {
+            law,
+            x,
+            v,
+            hf,
+            hk,
+            dt: inp.dt,
+            matrix: inp.matrix,
+            beta_s: fab.stretch_damping,
+            beta_b: fab.bend_damping,
+            fr_warp: law.tension_friction(Direction::Warp).filter(|_| friction),
+            fr_weft: law.tension_friction(Direction::Weft).filter(|_| friction),
+            fr_shear: law.shear_friction().filter(|_| friction),
+            fr_bend_u: law.bending_friction(Direction::Warp).filter(|_| friction),
+            fr_bend_v: law.bending_friction(Direction::Weft).filter(|_| friction),
+        };
+        let nsc = chunks(model.springs.len(), CHUNK);
+        let nqc = chunks(model.shear_quads.len(), CHUNK);
+        let nbc = chunks(model.bend_lines.len(), CHUNK);
         let (blocks_s, rest) = self.blocks.split_at_mut(self.quad_block0);
-        let (blocks_q, rest) = rest.split_at_mut(self.bend_block0 - self.quad_block0);
-        let blocks_b = rest;
+        let (blocks_q, blocks_b) = rest.split_at_mut(self.bend_block0 - self.quad_block0);
         let nh = model.hinges.len();
         let (blocks_h, blocks_a) = self.hinge_blocks.split_at_mut(16 * nh);
         let (g_s, rest) = self.g.split_at_mut(self.quad_g0);
@@ -275,301 +290,22 @@ impl Assembly {
         let (ep_q, rest) = rest.split_at_mut(nqc);
         let (ep_b, rest) = rest.split_at_mut(nbc);
         let (ep_h, ep_a) = rest.split_at_mut(chunks(nh, CHUNK));
-        let matrix = inp.matrix;
-        let friction = !self.fric_spring.is_empty();
-        let fr_warp = law.tension_friction(Direction::Warp).filter(|_| friction);
-        let fr_weft = law.tension_friction(Direction::Weft).filter(|_| friction);
-        let fr_shear = law.shear_friction().filter(|_| friction);
-        let fr_bend_u = law.bending_friction(Direction::Warp).filter(|_| friction);
-        let fr_bend_v = law.bending_friction(Direction::Weft).filter(|_| friction);
-        let (cm_s, cm_q, cm_b, cm_h) = (
-            &self.fric_spring,
-            &self.fric_quad,
-            &self.fric_bend,
-            &self.fric_hinge,
-        );
-        let st_s = SyncPtr(self.trial_spring.as_mut_ptr());
-        let st_q = SyncPtr(self.trial_quad.as_mut_ptr());
-        let st_b = SyncPtr(self.trial_bend.as_mut_ptr());
-        let st_h = SyncPtr(self.trial_hinge.as_mut_ptr());
-        // springs
-        model
-            .springs
-            .par_chunks(CHUNK)
-            .zip(blocks_s.par_chunks_mut(CHUNK))
-            .zip(g_s.par_chunks_mut(CHUNK))
-            .zip(ep_s.par_iter_mut())
-            .enumerate()
-            .for_each(|(c, (((sp, bl), g), ep))| {
-                let mut e = 0.0;
-                for k in 0..sp.len() {
-                    let s = &sp[k];
-                    let mut ev = s.eval(law, &x[s.a], &x[s.b]);
-                    e += ev.energy;
-                    let fr = match s.kind {
-                        SpringKind::Stretch { warp_weight } if warp_weight >= 0.5 => fr_warp,
-                        SpringKind::Stretch { .. } => fr_weft,
-                        SpringKind::Shear => fr_shear,
-                        SpringKind::Seam { .. } | SpringKind::Flexion { .. } => None,
-                    };
-                    let axial_el = ev.axial;
-                    if let Some(f) = fr {
-                        // SAFETY: element c·CHUNK + k is visited by this iteration only.
-                        let st = unsafe { &mut *st_s.at(c * CHUNK + k) };
-                        *st = cm_s[c * CHUNK + k];
-                        s.add_friction(&f, st, &x[s.a], &x[s.b], &mut ev);
-                    }
-                    let rel = v[s.b] - v[s.a];
-                    let damp = beta_s * axial_el * ev.dir.dot(&rel);
-                    let mut ga = ev.dir * ((ev.tension + damp) * hf);
-                    if matrix {
-                        let kmat = ev.stiffness();
-                        ga += kmat * rel * hk;
-                        let c = ev.dir * ev.dir.transpose() * (beta_s * axial_el);
-                        bl[k] = Sym3::from_upper(&(kmat * hk + c * inp.dt));
-                    }
-                    g[k] = ga;
-                }
-                *ep = e;
-            });
-        // shear cells: two spring-like diagonals each
-        model
-            .shear_quads
-            .par_chunks(CHUNK)
-            .zip(blocks_q.par_chunks_mut(2 * CHUNK))
-            .zip(g_q.par_chunks_mut(2 * CHUNK))
-            .zip(ep_q.par_iter_mut())
-            .enumerate()
-            .for_each(|(c, (((qs, bl), g), ep))| {
-                let mut e = 0.0;
-                for k in 0..qs.len() {
-                    let q = &qs[k];
-                    let sm = q.measure(x);
-                    let gamma = sm.gamma;
-                    let (mut hs, mut dhs, w) = law.shear(gamma);
-                    let dhs_el = dhs;
-                    if let Some(f) = fr_shear {
-                        // SAFETY: element c·CHUNK + k is visited by this iteration only.
-                        let st = unsafe { &mut *st_q.at(c * CHUNK + k) };
-                        *st = cm_q[c * CHUNK + k];
-                        if st[0].is_nan() {
-                            *st = [gamma, 0.0];
-                        }
-                        let (z, dz) = f.update(st[0], st[1], gamma, hs, dhs);
-                        *st = [gamma, z];
-                        hs += z;
-                        dhs += dz;
-                    }
-                    e += q.area * w;
-                    for m in 0..2 {
-                        let (a, b) = (q.nodes[2 * m], q.nodes[2 * m + 1]);
-                        let d = sm.d[m];
-                        // γ depends on |d|² with slope dg: ∂γ/∂x_b = 2 dg d
-                        let gk = 2.0 * sm.dg[m];
-                        let rel = v[b] - v[a];
-                        let ddt = d * d.transpose();
-                        let axial = ddt * (2.0 * q.area * gk * gk);
-                        let cdamp = axial * (beta_s * dhs_el);
-                        // force on the diagonal's first node (the second gets the opposite)
-                        let mut ga = d * (q.area * hs * gk * hf) + cdamp * rel * hf;
-                        if matrix {
-                            let kmat = axial * dhs.max(0.0)
-                                + Mat3::identity() * (q.area * hs * gk).max(0.0);
-                            ga += kmat * rel * hk;
-                            bl[2 * k + m] = Sym3::from_upper(&(kmat * hk + cdamp * inp.dt));
-                        }
-                        g[2 * k + m] = ga;
-                    }
-                }
-                *ep = e;
-            });
-        // bending lines
-        model
-            .bend_lines
-            .par_chunks(CHUNK)
-            .zip(blocks_b.par_chunks_mut(CHUNK))
-            .zip(g_b.par_chunks_mut(3 * CHUNK))
-            .zip(ep_b.par_iter_mut())
-            .enumerate()
-            .for_each(|(c, (((els, bl), g), ep))| {
-                let mut e = 0.0;
-                for k in 0..els.len() {
-                    let el = &els[k];
-                    let geo = el.geometry(x);
-                    let kappa = geo.qn.norm();
-                    let (m_el, dm, en) = law.bending(el.dir, kappa);
-                    let (mut mv, mut s) = BendLine::elastic(&geo, m_el, dm);
-                    let f2 = el.area * geo.scale * geo.scale;
-                    let s_el = s * f2;
-                    let fr = match el.dir {
-                        Direction::Warp => fr_bend_u,
-                        Direction::Weft => fr_bend_v,
-                    };
-                    if let Some(f) = fr {
-                        // SAFETY: element c·CHUNK + k is visited by this iteration only.
-                        let st = unsafe { &mut *st_b.at(c * CHUNK + k) };
-                        *st = cm_b[c * CHUNK + k];
-                        // scalar friction on the signed curvature, its sign kept continuous
-                        // through the reference direction st[1] (rotation does not slide it)
-                        let r_old = st[1];
-                        let sgn = if r_old.dot(&geo.qn) < 0.0 { -1.0 } else { 1.0 };
-                        let ks = sgn * kappa;
-                        if st[0].x.is_nan() {
-                            st[0] = Vec3::new(ks, 0.0, 0.0);
-                        }
-                        let (z, dz) = f.update(st[0].x, st[0].y, ks, sgn * m_el, dm);
-                        if kappa > 1e-9 {
-                            let qh = geo.qn / kappa;
-                            let qq = qh * qh.transpose();
-                            mv += qh * (sgn * z);
-                            s += qq * dz.max(0.0)
-                                + (Mat3::identity() - qq) * (sgn * z / kappa).max(0.0);
-                            st[1] = qh * sgn;
-                        } else {
-                            mv += r_old * z;
-                            s += Mat3::identity() * dz.max(0.0);
-                        }
-                        st[0] = Vec3::new(ks, z, 0.0);
-                    }
-                    let s = s * f2;
-                    e += el.area * en;
-                    let forces = el.forces(&geo, &mv);
-                    let [a, b, cc] = el.nodes;
-                    let w = v[a] * el.coef[0] + v[b] * el.coef[1] + v[cc] * el.coef[2];
-                    let sw = s * w;
-                    let dw = s_el * w * beta_b;
-                    // f_m − β c_m S_el w (damping), and the K v term c_m S w
-                    for m in 0..3 {
-                        let cm = el.coef[m];
-                        g[3 * k + m] = (forces[m] - dw * cm) * hf - sw * (cm * hk);
-                    }
-                    if matrix {
-                        bl[k] = Sym3::from_upper(&(s * hk + s_el * (inp.dt * beta_b)));
-                    }
-                }
-                *ep = e;
-            });
-        // hinges
-        let hinge_e: f64 = if model.hinges.is_empty() {
-            0.0
-        } else {
-            model
-                .hinges
-                .par_chunks(CHUNK)
-                .zip(blocks_h.par_chunks_mut(16 * CHUNK))
-                .zip(g_h.par_chunks_mut(4 * CHUNK))
-                .zip(ep_h.par_iter_mut())
-                .enumerate()
-                .for_each(|(c, (((els, bl), g), ep))| {
-                    let mut e = 0.0;
-                    for k in 0..els.len() {
-                        let el = &els[k];
-                        let angle = if el.weight > 0.0 {
-                            el.angle_and_gradient(x)
-                        } else {
-                            None
-                        };
-                        let Some((theta, grad)) = angle else {
-                            clear_four_node_element(g, bl, k);
-                            continue;
-                        };
-                        let kappa = theta.abs() * el.edge / el.area;
-                        let (mo, dm, w) = el.law(law, kappa);
-                        let (mo, dm, w) = (mo * el.weight, dm * el.weight, w * el.weight);
-                        e += el.area * w;
-                        // signed moment per width and its tangent in signed curvature
-                        let (mut ms, mut dms) = (mo * theta.signum(), dm);
-                        let fr = if el.warp_weight >= 0.5 {
-                            fr_bend_u
-                        } else {
-                            fr_bend_v
-                        };
-                        if let Some(f) = fr {
-                            // SAFETY: element c·CHUNK + k is visited by this iteration only.
-                            let st = unsafe { &mut *st_h.at(c * CHUNK + k) };
-                            *st = cm_h[c * CHUNK + k];
-                            let ks = theta * el.edge / el.area;
-                            if st[0].is_nan() {
-                                *st = [ks, 0.0];
-                            }
-                            let (z, dz) = f.update(st[0], st[1], ks, ms, dms);
-                            *st = [ks, z];
-                            ms += z;
-                            dms += dz;
-                        }
-                        let dedtheta = el.edge * ms;
-                        let stiff_el = dm * el.edge * el.edge / el.area;
-                        let stiff = dms.max(0.0) * el.edge * el.edge / el.area;
-                        let gv: f64 = (0..4).map(|m| grad[m].dot(&v[el.nodes[m]])).sum();
-                        for m in 0..4 {
-                            g[4 * k + m] = -grad[m]
-                                * (dedtheta * hf + stiff_el * gv * beta_b * hf + stiff * gv * hk);
-                            if matrix {
-                                for q in 0..4 {
-                                    bl[16 * k + 4 * m + q] = grad[m]
-                                        * grad[q].transpose()
-                                        * (stiff * hk + stiff_el * inp.dt * beta_b);
-                                }
-                            }
-                        }
-                    }
-                    *ep = e;
-                });
-            ordered_sum(&ep_h[..chunks(model.hinges.len(), CHUNK)])
-        };
-        // Choi–Ko's arc connections: the stable part axial · ∇l ∇lᵀ, stretch damping
-        let arc_e: f64 = if model.arcs.is_empty() {
-            0.0
-        } else {
-            model
-                .arcs
-                .par_chunks(CHUNK)
-                .zip(blocks_a.par_chunks_mut(16 * CHUNK))
-                .zip(g_a.par_chunks_mut(4 * CHUNK))
-                .zip(ep_a.par_iter_mut())
-                .for_each(|(((els, bl), g), ep)| {
-                    let mut e = 0.0;
-                    for k in 0..els.len() {
-                        let el = &els[k];
-                        let Some(ev) = el.eval(law, x) else {
-                            clear_four_node_element(g, bl, k);
-                            continue;
-                        };
-                        e += ev.energy;
-                        let grad = ev.grad;
-                        // the matrix's part of the gradient: along the chord, on the ends
-                        let gc = [-ev.chord, ev.chord, Vec3::zeros(), Vec3::zeros()];
-                        let rate: f64 = (0..4).map(|m| grad[m].dot(&v[el.nodes[m]])).sum();
-                        let rate_c = ev.chord.dot(&(v[el.nodes[1]] - v[el.nodes[0]]));
-                        let force = (ev.tension + beta_s * ev.axial * rate) * hf;
-                        let kv = ev.axial * rate_c * hk;
-                        let kc = ev.axial * (hk + beta_s * inp.dt);
-                        // the arc's bending stiffness acts on the middle's offset from the
-                        // ends' midpoint, m − (a + c)/2: weights −½, −½, ½, ½
-                        const W: [f64; 4] = [-0.5, -0.5, 0.5, 0.5];
-                        let vr =
-                            (v[el.nodes[2]] + v[el.nodes[3]] - v[el.nodes[0]] - v[el.nodes[1]])
-                                * 0.5;
-                        let mv = ev.middle * vr * hk;
-                        for m in 0..4 {
-                            g[4 * k + m] = -grad[m] * force - gc[m] * kv - mv * W[m];
-                            if matrix {
-                                for q in 0..4 {
-                                    bl[16 * k + 4 * m + q] = gc[m] * gc[q].transpose() * kc
-                                        + ev.middle * (W[m] * W[q] * hk);
-                                }
-                            }
-                        }
-                    }
-                    *ep = e;
-                });
-            ordered_sum(&ep_a[..chunks(model.arcs.len(), CHUNK)])
-        };
-        ordered_sum(&ep_s[..nsc])
-            + ordered_sum(&ep_q[..nqc])
-            + ordered_sum(&ep_b[..nbc])
-            + hinge_e
-            + arc_e
+        let trial_s = SyncPtr(self.trial_spring.as_mut_ptr());
+        let trial_q = SyncPtr(self.trial_quad.as_mut_ptr());
+        let trial_b = SyncPtr(self.trial_bend.as_mut_ptr());
+        let trial_h = SyncPtr(self.trial_hinge.as_mut_ptr());
+        let no_state = SyncPtr(std::ptr::null_mut());
+        let els = &model.springs;
+        let e_s = contribute_all(els, &p, blocks_s, g_s, ep_s, &self.fric_spring, trial_s);
+        let els = &model.shear_quads;
+        let e_q = contribute_all(els, &p, blocks_q, g_q, ep_q, &self.fric_quad, trial_q);
+        let els = &model.bend_lines;
+        let e_b = contribute_all(els, &p, blocks_b, g_b, ep_b, &self.fric_bend, trial_b);
+        let els = &model.hinges;
+        let e_h = contribute_all(els, &p, blocks_h, g_h, ep_h, &self.fric_hinge, trial_h);
+        let els = &model.arcs;
+        let e_a = contribute_all(els, &p, blocks_a, g_a, ep_a, &[], no_state);
+        e_s + e_q + e_b + e_h + e_a
     }
 
     fn gather_pass(&mut self, model: &ClothModel, v: &[Vec3], inp: AssemblyInputs) {
@@ -725,13 +461,6 @@ impl Assembly {
 
 /// Inverse of a diagonal block, or a scaled identity if it is singular.
 #[inline]
-/// Zeroes the force terms and the 4 × 4 stiffness blocks of four-node element `k` of a chunk
-/// (a hinge or an arc that contributes nothing this step).
-fn clear_four_node_element(g: &mut [Vec3], blocks: &mut [Mat3], k: usize) {
-    g[4 * k..4 * k + 4].fill(Vec3::zeros());
-    blocks[16 * k..16 * k + 16].fill(Mat3::zeros());
-}
-
 fn block_inverse(d: &Mat3) -> Mat3 {
     d.try_inverse()
         .unwrap_or_else(|| Mat3::identity() / d.trace().max(1e-300))

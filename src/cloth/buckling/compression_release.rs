@@ -25,9 +25,10 @@
 //! the self-collision response stops short of its destination is let go, and waits
 //! `hold_steps` before it is released again.
 
-use super::constraints::{ContactHook, Filter, Obstacles, ParticleFilter};
-use super::elements::SpringKind;
-use super::model::ClothModel;
+use crate::cloth::constraints::{Filter, ParticleFilter};
+use crate::cloth::elements::SpringKind;
+use crate::cloth::model::ClothModel;
+use crate::cloth::stage::{Obstacles, StepStage};
 use crate::geometry::Vec3;
 
 /// The farthest a release moves a particle to the far intersection, in rest lengths of the
@@ -355,7 +356,7 @@ impl CompressionRelease {
 
     /// The strain of particle `m`'s ring of stretch springs were it at `p`: the sum of
     /// squared strains, compressed and stretched (the ring's elastic energy up to stiffness).
-    fn ring_strain(&self, x: &[Vec3], m: usize, p: &Vec3) -> f64 {
+    pub fn ring_strain(&self, x: &[Vec3], m: usize, p: &Vec3) -> f64 {
         self.ring(m)
             .map(|(k, r)| ((x[k] - p).norm() / r - 1.0).powi(2))
             .sum()
@@ -456,7 +457,7 @@ impl CompressionRelease {
     }
 }
 
-impl ContactHook for CompressionRelease {
+impl StepStage for CompressionRelease {
     fn constrain(
         &mut self,
         x: &[Vec3],
@@ -524,6 +525,14 @@ impl ContactHook for CompressionRelease {
             }
         }
         self.order = order;
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+
+    fn as_any_mut(&mut self) -> &mut dyn std::any::Any {
+        self
     }
 }
 

@@ -1,0 +1,100 @@
+//! Settings of a simulation: the time integrator, the implicit solve's preconditioner and
+//! tolerances, the step, gravity and the divergence guard, each checked when set.
+
+use serde::{Deserialize, Serialize};
+
+use super::ClothError;
+
+/// Time integrator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Integrator {
+    /// Linearised backward Euler with the modified PCG (Baraff & Witkin).
+    Implicit,
+    /// Symplectic Euler with `explicit_substeps` substeps per step.
+    Explicit,
+}
+
+/// Which preconditioner the implicit solve uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PreconditionerKind {
+    /// Multigrid on grid cloths of at least 16 × 16 particles, aggregation multigrid on other
+    /// cloths of at least `AGGREGATION_MIN` particles, block-Jacobi otherwise.
+    Auto,
+    /// Inverse diagonal 3×3 blocks.
+    BlockJacobi,
+    /// Geometric multigrid V-cycle with line smoothing (grid cloths only).
+    Multigrid,
+    /// Aggregation (algebraic) multigrid V-cycle with block Gauss–Seidel smoothing (any mesh).
+    Aggregation,
+}
+
+/// Smallest non-grid cloth that [`PreconditionerKind::Auto`] preconditions with aggregation
+/// multigrid.
+pub const AGGREGATION_MIN: usize = 1000;
+
+/// Settings of a simulation, SI units; every field settable on its own.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct SimulationParameters {
+    /// Step length (s).
+    pub dt: f64,
+    /// Which integrator advances the state.
+    pub integrator: Integrator,
+    /// Gravity (m/s²).
+    pub gravity: [f64; 3],
+    /// CG relative residual tolerance.
+    pub cg_tolerance: f64,
+    /// CG iteration cap.
+    pub cg_max_iterations: u32,
+    /// Start CG from the previous step's velocity change.
+    pub warm_start: bool,
+    /// Substeps per step for the explicit integrator.
+    pub explicit_substeps: u32,
+    /// A particle faster than this (m/s) means the simulation blew up.
+    pub max_speed: f64,
+    /// Preconditioner of the implicit solve.
+    pub preconditioner: PreconditionerKind,
+}
+
+impl Default for SimulationParameters {
+    fn default() -> Self {
+        SimulationParameters {
+            dt: 1.0 / 120.0,
+            integrator: Integrator::Implicit,
+            gravity: [0.0, 0.0, -9.81],
+            cg_tolerance: 1e-3,
+            cg_max_iterations: 500,
+            warm_start: true,
+            explicit_substeps: 1,
+            max_speed: 200.0,
+            preconditioner: PreconditionerKind::Auto,
+        }
+    }
+}
+
+impl SimulationParameters {
+    /// Checks the values, naming the first bad parameter.
+    pub fn validate(&self) -> Result<(), ClothError> {
+        let bad = |name: &str, v: f64| {
+            ClothError::Parameter(format!("simulation parameter `{name}` is invalid: {v}"))
+        };
+        if !(self.dt.is_finite() && self.dt > 0.0) {
+            return Err(bad("dt", self.dt));
+        }
+        if !(self.cg_tolerance.is_finite() && self.cg_tolerance > 0.0) {
+            return Err(bad("cg_tolerance", self.cg_tolerance));
+        }
+        if self.max_speed.is_nan() || self.max_speed <= 0.0 {
+            return Err(bad("max_speed", self.max_speed));
+        }
+        if let Some(g) = self.gravity.iter().find(|g| !g.is_finite()) {
+            return Err(bad("gravity", *g));
+        }
+        if self.explicit_substeps == 0 {
+            return Err(bad("explicit_substeps", 0.0));
+        }
+        Ok(())
+    }
+}
