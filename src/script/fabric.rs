@@ -81,7 +81,8 @@ fn checked(p: FabricParameters) -> RResult<Fabric> {
     Ok(Fabric(p))
 }
 
-/// Registers `fabric`, its properties, `cloth_grid`, `cloth_obj` and the `Cloth` properties.
+/// Registers `cloth::fabric`, its properties, `cloth::grid`, `cloth::cone`, `cloth::patch`,
+/// `cloth::from_obj` and the `Cloth` methods and properties.
 pub fn register(engine: &mut ApiBuilder) {
     engine.register_type_with_name::<Fabric>("Fabric");
     engine.register_type_with_name::<ClothHandle>("Cloth");
@@ -90,7 +91,7 @@ pub fn register(engine: &mut ApiBuilder) {
         "The default fabric: a cotton-like woven (0.15 kg/m², 1000 N/m stretch, soft shear and bending).\nChange fields with `f.density = 0.2`.",
         Fabric::default);
     function!(engine, "cloth::fabric", alias = "fabric", ["params: Map", "Fabric"],
-        "A fabric from a map of fields, e.g. `fabric(#{density: 0.2, stretch_warp: 800.0})`;\nunset fields keep their defaults. Unknown keys, negative or non-finite values are errors\nthat name the parameter.",
+        "A fabric from a map of fields, e.g. `cloth::fabric(#{density: 0.2, stretch_warp: 800.0})`;\nunset fields keep their defaults. Unknown keys, negative or non-finite values are errors\nthat name the parameter.",
         |m: Map| -> RResult<Fabric> { checked(update_from_map(&FabricParameters::default(), &m, "fabric")?) });
     register!(
         engine,

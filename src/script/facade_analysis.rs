@@ -107,7 +107,7 @@ fn factors(d: &Dynamic, what: &str) -> RResult<Vec<f64>> {
 }
 
 /// Reads the rule file at `rules` and writes the facades it generates (see
-/// `facade_from_rules`).
+/// `facade::from_rules`).
 fn from_rules(rules: &str, out: &str, stem: &str, m: &Map) -> RResult<Array> {
     let (mut scale, mut texture) = (0.01, None::<String>);
     let mut opts = OutputOptions {
@@ -182,7 +182,7 @@ unreadable file is an error; a failed rectification or parse is reported by `pro
         "facade::analyze",
         alias = "analyze_facade",
         ["path: String", "options: Map", "FacadeAnalysis"],
-        "As `analyze_facade(path)` with options: `rectify` (\"auto\" or \"none\"), `corners`
+        "As `facade::analyze(path)` with options: `rectify` (\"auto\" or \"none\"), `corners`
 (four points [x, y] in photo pixels, top-left, top-right, bottom-right, bottom-left: the
 facade quadrilateral to rectify instead), `floor` and `tile` ([min, max] as fractions of the
 photo's height and width), `window` ([min, max] fractions of a tile).",

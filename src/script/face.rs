@@ -288,7 +288,7 @@ metres), `backgrounds` (folder of photos), `faps` (array of FAP numbers). Return
         "face::track",
         alias = "face_track",
         ["seq: String", "out: String", "options: Map", "Map"],
-        "Tracks the head pose and expression in a face sequence folder (as `make_face_sequence`
+        "Tracks the head pose and expression in a face sequence folder (as `face::make_sequence`
 writes: cameras, images, the neutral `model.obj` and `init.csv` with the first frame's pose
 and FAPs): the model is textured from the first frame, then each frame's pose is found by
 Gauss–Newton on the photometric error and its FAP values by simulated annealing. Writes
@@ -321,7 +321,7 @@ as `Mouth width` or `Left eyelid`, then the six basic expressions `smile`, `surp
         ["path: String", "values: Map", "()"],
         "Renders the generic face (MediaPipe canonical mesh with a procedural skin texture,
 shaded, frontal, 512×512) with an expression to a PNG: `values` maps slider names (see
-`face_sliders`) and MPEG-4 FAPs written `fap_N` (in FAP units: value / 1024 × FAPU) to their
+`face::sliders`) and MPEG-4 FAPs written `fap_N` (in FAP units: value / 1024 × FAPU) to their
 values, e.g. #{ smile: 1.0 } or #{ fap_3: 800 }.",
         |path: &str, m: Map| expression_png(path, &m, 0.0)
     );
@@ -330,7 +330,7 @@ values, e.g. #{ smile: 1.0 } or #{ fap_3: 800 }.",
         "face::expression_png",
         alias = "face_expression_png",
         ["path: String", "values: Map", "yaw_deg: f64", "()"],
-        "As `face_expression_png(path, values)`, seen from `yaw_deg` degrees to the side
+        "As `face::expression_png(path, values)`, seen from `yaw_deg` degrees to the side
 (positive: from the subject's left).",
         |path: &str, m: Map, yaw: f64| expression_png(path, &m, yaw)
     );
@@ -372,7 +372,7 @@ names, texture_coverage, mean_abs_change_mm, files}.",
         "Starts a step-by-step adaptation of the generic face to the photos of `images` that have
 a `.pts` file of the same stem (option `pts`: the folder of the .pts files). Then call
 `calibrate`, `adapt_contours`, `deform` and `refine_cameras` in that order; `undo` returns to
-the state before the last step; `write` writes the outputs as `face_fit` does.",
+the state before the last step; `write` writes the outputs as `face::fit` does.",
         |images: &str, m: Map| start(images, &m)
     );
     register!(
@@ -442,7 +442,7 @@ eye corners); NaN before `calibrate`.",
         engine,
         "write",
         ["fit: FaceFit", "out: String", "Map"],
-        "Writes the outputs of the adaptation in its current state under `out` (as `face_fit`:
+        "Writes the outputs of the adaptation in its current state under `out` (as `face::fit`:
 textured OBJ and glb, overlays, renders, error map, fit.csv); returns #{images,
 landmark_err_iod_pct, texture_coverage, files}.",
         |s: &mut FaceFitSession, out: &str| -> RResult<Map> {

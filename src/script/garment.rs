@@ -1,5 +1,5 @@
 //! Script bindings for garments: pattern files (garment tables, JSON, SVG, DXF-AAMA) as a
-//! `Pattern` handle, and `dress`, which meshes, pre-positions and sews a pattern on the
+//! `Pattern` handle, and `garment::dress`, which meshes, pre-positions and sews a pattern on the
 //! mannequin into a `Simulation`.
 
 use std::path::Path;
@@ -42,7 +42,7 @@ fn read_any(path: &str) -> Result<Pattern, PatternError> {
     }
 }
 
-/// `dress` for both kinds of fabric: a linear one, or a density with a measured law.
+/// `garment::dress` for both kinds of fabric: a linear one, or a density with a measured law.
 fn dress_on_mannequin(
     pattern: &Pattern,
     fabric: FabricParameters,
@@ -107,7 +107,7 @@ pub fn register(engine: &mut ApiBuilder) {
             dress_on_mannequin(&p.0, f.0, None, m)
         });
     function!(engine, "garment::dress", alias = "dress", ["pattern: Pattern", "fabric: KesFabric", "options: Map", "Simulation"],
-        "As `dress` with a fabric file (`kes_fabric`): the garment takes the fabric's areal density\nand its material law from its measurements (KES parameters or curves, uncalibrated).",
+        "As `garment::dress` with a fabric file (`kes::fabric`): the garment takes the fabric's areal density\nand its material law from its measurements (KES parameters or curves, uncalibrated).",
         |p: &mut PatternHandle, f: KesFabric, m: Map| -> RResult<SimHandle> {
             let (params, law) = measured_fabric(&f.0).map_err(rt_err)?;
             dress_on_mannequin(&p.0, params, Some(Arc::new(law)), m)

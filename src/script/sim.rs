@@ -169,7 +169,7 @@ fn run_n(h: &SimHandle, n: u64) -> RResult<()> {
     Ok(())
 }
 
-/// Registers `simulation` and the `Simulation` methods for constraints and stepping.
+/// Registers `cloth::simulation` and the `Simulation` methods for constraints and stepping.
 pub fn register(engine: &mut ApiBuilder) {
     engine.register_type_with_name::<SimHandle>("Simulation");
     let new_sim = |c: &ClothHandle, m: &Map| -> RResult<SimHandle> {

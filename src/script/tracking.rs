@@ -134,7 +134,7 @@ pub fn register(engine: &mut ApiBuilder) {
         "track::body",
         alias = "track_body",
         ["seq: String", "out: String", "Map"],
-        "Tracks the body in a sequence folder (the layout `make_sequence` writes: cameras,
+        "Tracks the body in a sequence folder (the layout `track::make_sequence` writes: cameras,
 images per camera, `init_joints.csv` with an approximate first pose, and
 `ground_truth.csv` when known) by analysis-by-synthesis: the textured puppet rendered into
 every camera, its joint angles found frame by frame by annealing. Writes under `out`: the
@@ -149,7 +149,7 @@ truth), s_per_frame, stage_seconds (per frame), start_seconds, files}.",
         "track::body",
         alias = "track_body",
         ["seq: String", "out: String", "options: Map", "Map"],
-        "As `track_body(seq, out)` with options: `particles` per layer, `layers` (pyramid level
+        "As `track::body(seq, out)` with options: `particles` per layer, `layers` (pyramid level
 of each annealing layer, coarse first, e.g. [1, 1, 1, 0, 0]), `robust_sigma` (grey levels),
 `mesh_cell` (metres), `lbs` (linear blend skinning instead of rigid), `background_frames`,
 `prediction` (velocity factor), `prior_weight` (motion prior per squared move spread,

@@ -1,4 +1,4 @@
-//! Script bindings of the synthetic multi-camera sequences: `make_sequence`.
+//! Script bindings of the synthetic multi-camera sequences: `track::make_sequence`.
 
 use std::path::Path;
 
@@ -8,7 +8,7 @@ use super::convert::{rt_err, RResult};
 use super::{function, modules::ApiBuilder};
 use crate::tracking::sequence::{make_sequence, SequenceOptions, SequenceSummary};
 
-/// Option keys of `make_sequence(motion, out, options)`.
+/// Option keys of `track::make_sequence(motion, out, options)`.
 const KEYS: [&str; 14] = [
     "cameras",
     "width",
@@ -143,7 +143,7 @@ fn run(motion: &str, out: &str, o: &SequenceOptions) -> RResult<Map> {
     Ok(summary_map(&s))
 }
 
-/// Registers `make_sequence`.
+/// Registers `track::make_sequence`.
 pub fn register(engine: &mut ApiBuilder) {
     function!(
         engine,
@@ -163,7 +163,7 @@ Returns #{frames, cameras, width, height, seconds, seconds_per_frame, dir}.",
         "track::make_sequence",
         alias = "make_sequence",
         ["motion: String", "out: String", "options: Map", "Map"],
-        "As `make_sequence(motion, out)` with options (numbers may be given as strings):
+        "As `track::make_sequence(motion, out)` with options (numbers may be given as strings):
 `cameras` (1–64), `width`, `height` (pixels), `fps`, `frames` (default: the whole clip),
 `start` (clip time of frame 0, s), `noise` (Gaussian sigma, grey levels, default 4),
 `lighting` (amplitude of the light changes, default 0.15), `occluder` (fraction of each
