@@ -5,12 +5,12 @@
 use std::fmt;
 use std::path::Path;
 
-use rhai::{Dynamic, Engine, Map, Shared, INT};
+use rhai::{Dynamic, Map, Shared, INT};
 
 use super::convert::{
     count, get_field, num, rt_err, to_map, update_field, update_from_map, RResult,
 };
-use super::{getter, register};
+use super::{function, getter, modules::ApiBuilder, register};
 use crate::cloth::{ClothModel, FabricParameters};
 use crate::geometry::read_obj;
 
@@ -81,16 +81,17 @@ fn checked(p: FabricParameters) -> RResult<Fabric> {
     Ok(Fabric(p))
 }
 
-/// Registers `fabric`, its properties, `cloth_grid`, `cloth_obj` and the `Cloth` properties.
-pub fn register(engine: &mut Engine) {
+/// Registers `cloth::fabric`, its properties, `cloth::grid`, `cloth::cone`, `cloth::patch`,
+/// `cloth::from_obj` and the `Cloth` methods and properties.
+pub fn register(engine: &mut ApiBuilder) {
     engine.register_type_with_name::<Fabric>("Fabric");
     engine.register_type_with_name::<ClothHandle>("Cloth");
 
-    register!(engine, "fabric", ["Fabric"],
+    function!(engine, "cloth::fabric", alias = "fabric", ["Fabric"],
         "The default fabric: a cotton-like woven (0.15 kg/m², 1000 N/m stretch, soft shear and bending).\nChange fields with `f.density = 0.2`.",
         Fabric::default);
-    register!(engine, "fabric", ["params: Map", "Fabric"],
-        "A fabric from a map of fields, e.g. `fabric(#{density: 0.2, stretch_warp: 800.0})`;\nunset fields keep their defaults. Unknown keys, negative or non-finite values are errors\nthat name the parameter.",
+    function!(engine, "cloth::fabric", alias = "fabric", ["params: Map", "Fabric"],
+        "A fabric from a map of fields, e.g. `cloth::fabric(#{density: 0.2, stretch_warp: 800.0})`;\nunset fields keep their defaults. Unknown keys, negative or non-finite values are errors\nthat name the parameter.",
         |m: Map| -> RResult<Fabric> { checked(update_from_map(&FabricParameters::default(), &m, "fabric")?) });
     register!(
         engine,
@@ -132,14 +133,14 @@ pub fn register(engine: &mut Engine) {
             });
     }
 
-    register!(engine, "cloth_grid", ["width: float", "height: float", "nx: int", "ny: int", "fabric: Fabric", "Cloth"],
+    function!(engine, "cloth::grid", alias = "cloth_grid", ["width: float", "height: float", "nx: int", "ny: int", "fabric: Fabric", "Cloth"],
         "A `width` × `height` m rectangle of `nx` × `ny` particles, flat in the XY plane at z = 0,\ncentred at the origin. Particle (row i along y, column j along x) has index `i * nx + j`;\nthe y = +height/2 edge is \"top\".",
         |w: Dynamic, h: Dynamic, nx: INT, ny: INT, f: Fabric| -> RResult<ClothHandle> {
             let (w, h) = (num(&w, "width")?, num(&h, "height")?);
             let (nx, ny) = (count(&Dynamic::from_int(nx), "nx")?, count(&Dynamic::from_int(ny), "ny")?);
             Ok(ClothHandle(Shared::new(ClothModel::grid(w, h, nx, ny, f.0)?)))
         });
-    register!(engine, "cloth_cone", ["r_top: float", "r_bottom: float", "height: float", "n_around: int", "n_down: int", "fabric: Fabric", "base: Array", "slit: float", "Cloth"],
+    function!(engine, "cloth::cone", alias = "cloth_cone", ["r_top: float", "r_bottom: float", "height: float", "n_around: int", "n_down: int", "fabric: Fabric", "base: Array", "slit: float", "Cloth"],
         "A truncated cone of cloth around the vertical axis through `base` (centre of its lower rim):\nradius `r_bottom` at the bottom, `r_top` at `height` above, cut from its exact flat pattern\n(an annular sector; equal radii give a cylinder). `n_around` × `n_down` particles; row i from\nthe bottom rim up, so the last `n_around` particles are the top rim. A slit of `slit` (a\nfraction of the circumference) is left open at the back (+y). An A-line skirt or a tube.",
         |rt: Dynamic, rb: Dynamic, h: Dynamic, na: INT, nd: INT, f: Fabric, base: Dynamic, slit: Dynamic| -> RResult<ClothHandle> {
             let (na, nd) = (count(&Dynamic::from_int(na), "n_around")?, count(&Dynamic::from_int(nd), "n_down")?);
@@ -149,9 +150,10 @@ pub fn register(engine: &mut Engine) {
             )?;
             Ok(ClothHandle(Shared::new(ClothModel::from_mesh(mesh, f.0)?)))
         });
-    register!(
+    function!(
         engine,
-        "cloth_patch",
+        "cloth::patch",
+        alias = "cloth_patch",
         ["width: float", "height: float", "edge: float", "fabric: Fabric", "Cloth"],
         "A `width` × `height` m rectangle meshed with irregular triangles about `edge` m long (the\npattern mesher's constrained Delaunay), flat in the XY plane at z = 0, centred at the\norigin, the warp along x: a triangle-mesh cloth (hinges, no grid lines).",
         |w: Dynamic, h: Dynamic, e: Dynamic, f: Fabric| -> RResult<ClothHandle> {
@@ -164,9 +166,10 @@ pub fn register(engine: &mut Engine) {
             Ok(ClothHandle(Shared::new(ClothModel::from_mesh(mesh, f.0)?)))
         }
     );
-    register!(
+    function!(
         engine,
-        "cloth_obj",
+        "cloth::from_obj",
+        alias = "cloth_obj",
         ["path: String", "fabric: Fabric", "Cloth"],
         "A cloth from an OBJ mesh whose texture coordinates are the flat pattern (m).",
         |path: &str, f: Fabric| -> RResult<ClothHandle> {

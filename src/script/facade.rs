@@ -3,10 +3,10 @@
 
 use std::path::Path;
 
-use rhai::{Array, Dynamic, Engine, Map, INT};
+use rhai::{Array, Dynamic, Map, INT};
 
 use super::convert::{rt_err, RResult};
-use super::register;
+use super::{function, modules::ApiBuilder, register};
 use crate::facade::instances::window_instances;
 use crate::facade::report::{labelled_images, summarize, write_summary};
 use crate::facade::{Class, FacadeParse, FacadeScore, ImageReport, LabelMap};
@@ -25,13 +25,14 @@ fn rect_map(r: &crate::facade::Rect) -> Map {
 }
 
 /// Registers the facade functions.
-pub fn register(engine: &mut Engine) {
+pub fn register(engine: &mut ApiBuilder) {
     engine.register_type_with_name::<Labels>("FacadeLabels");
     engine.register_type_with_name::<FacadeParse>("FacadeParse");
     engine.register_type_with_name::<ImageReport>("FacadeReport");
-    register!(
+    function!(
         engine,
-        "labelled_facades",
+        "facade::labelled",
+        alias = "labelled_facades",
         ["dir: String", "Array"],
         "Names (file stems, sorted) of the photos in `dir/images` that have a label map
 `dir/labels/NAME.png` (the LabelMeFacade layout).",
@@ -40,9 +41,10 @@ pub fn register(engine: &mut Engine) {
             Ok(names.into_iter().map(Dynamic::from).collect())
         }
     );
-    register!(
+    function!(
         engine,
-        "facade_labels",
+        "facade::labels",
+        alias = "facade_labels",
         ["path: String", "FacadeLabels"],
         "Reads a LabelMeFacade label map (PNG) into the canonical classes: window, wall
 (building), door, background (sky) and ignore (various, car, vegetation, pavement, road).
@@ -72,17 +74,19 @@ rectangle or more is hidden by ignored pixels.",
                 .collect()
         }
     );
-    register!(
+    function!(
         engine,
-        "all_wall_parse",
+        "facade::all_wall_parse",
+        alias = "all_wall_parse",
         ["labels: FacadeLabels", "FacadeParse"],
         "The all-wall baseline parse for an image the size of `labels`: every pixel wall, no
 window (about 0.8 pixel accuracy on street photos, window IoU 0).",
         |l: &mut Labels| -> FacadeParse { FacadeParse::all_wall(l.0.width, l.0.height) }
     );
-    register!(
+    function!(
         engine,
-        "score_facade",
+        "facade::score",
+        alias = "score_facade",
         [
             "name: String",
             "parse: FacadeParse",
@@ -131,9 +135,10 @@ missed, precision, recall, f1}.",
             m
         }
     );
-    register!(
+    function!(
         engine,
-        "facade_summary",
+        "facade::summary",
+        alias = "facade_summary",
         ["reports: Array", "method: String", "out: String", "Map"],
         "Writes `out/facades.csv` and `out/facades.md` (a row per image and the summary) and
 returns #{images, window_iou, f1 (per-image means), pixel_accuracy, pooled_window_iou

@@ -5,11 +5,11 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use rhai::{Array, Dynamic, Engine, Map, INT};
+use rhai::{Array, Dynamic, Map, INT};
 
 use super::convert::{finite, rt_err, RResult};
 use super::facade::Labels;
-use super::{getter, register};
+use super::{function, getter, modules::ApiBuilder, register};
 use crate::facade::analysis::{analyze, Analysis, Options, Rectify};
 use crate::facade::facade_mesh::MeshParams;
 use crate::facade::grammar::{Body, Grammar};
@@ -107,7 +107,7 @@ fn factors(d: &Dynamic, what: &str) -> RResult<Vec<f64>> {
 }
 
 /// Reads the rule file at `rules` and writes the facades it generates (see
-/// `facade_from_rules`).
+/// `facade::from_rules`).
 fn from_rules(rules: &str, out: &str, stem: &str, m: &Map) -> RResult<Array> {
     let (mut scale, mut texture) = (0.01, None::<String>);
     let mut opts = OutputOptions {
@@ -165,22 +165,24 @@ fn run(path: &str, o: &Options) -> RResult<FacadeAnalysis> {
 }
 
 /// Registers the facade pipeline functions.
-pub fn register(engine: &mut Engine) {
+pub fn register(engine: &mut ApiBuilder) {
     engine.register_type_with_name::<FacadeAnalysis>("FacadeAnalysis");
-    register!(
+    function!(
         engine,
-        "analyze_facade",
+        "facade::analyze",
+        alias = "analyze_facade",
         ["path: String", "FacadeAnalysis"],
         "Analyses a facade photo: automatic rectification from its vanishing points, floors and
 tiles by mutual information, the irreducible tile and its window, the shape grammar. An
 unreadable file is an error; a failed rectification or parse is reported by `problem`.",
         |path: &str| run(path, &Options::default())
     );
-    register!(
+    function!(
         engine,
-        "analyze_facade",
+        "facade::analyze",
+        alias = "analyze_facade",
         ["path: String", "options: Map", "FacadeAnalysis"],
-        "As `analyze_facade(path)` with options: `rectify` (\"auto\" or \"none\"), `corners`
+        "As `facade::analyze(path)` with options: `rectify` (\"auto\" or \"none\"), `corners`
 (four points [x, y] in photo pixels, top-left, top-right, bottom-right, bottom-left: the
 facade quadrilateral to rectify instead), `floor` and `tile` ([min, max] as fractions of the
 photo's height and width), `window` ([min, max] fractions of a tile).",
@@ -330,9 +332,10 @@ agrees with the parse (1 = lossless); 0 when the parse failed.",
             }
         }
     );
-    register!(
+    function!(
         engine,
-        "facade_from_rules",
+        "facade::from_rules",
+        alias = "facade_from_rules",
         [
             "rules: String",
             "out: String",

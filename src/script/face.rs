@@ -4,11 +4,11 @@ use std::io::IsTerminal;
 use std::path::Path;
 
 use indicatif::ProgressBar;
-use rhai::{Dynamic, Engine, Map, INT};
+use rhai::{Dynamic, Map, INT};
 
 use super::convert::{rt_err, RResult};
-use super::register;
 use super::tracking_sequence::{number, whole};
+use super::{function, modules::ApiBuilder, register};
 use crate::face::adapt::AdaptOptions;
 use crate::face::adapt::FaceFit;
 use crate::face::blendshapes::write_arkit_glb;
@@ -267,10 +267,11 @@ fn session_error(s: &FaceFitSession) -> f64 {
 }
 
 /// Registers the face functions.
-pub fn register(engine: &mut Engine) {
-    register!(
+pub fn register(engine: &mut ApiBuilder) {
+    function!(
         engine,
-        "make_face_sequence",
+        "face::make_sequence",
+        alias = "make_face_sequence",
         ["out: String", "options: Map", "Map"],
         "Writes a synthetic face sequence with ground truth under `out`: the neutral model
 (`model.obj`), its pose and expression (MPEG-4 FAP values) per frame (`ground_truth.csv`,
@@ -283,11 +284,12 @@ metres), `backgrounds` (folder of photos), `faps` (array of FAP numbers). Return
 #{frames, cameras, faps}.",
         |out: &str, m: Map| make(out, &m)
     );
-    register!(
+    function!(
         engine,
-        "face_track",
+        "face::track",
+        alias = "face_track",
         ["seq: String", "out: String", "options: Map", "Map"],
-        "Tracks the head pose and expression in a face sequence folder (as `make_face_sequence`
+        "Tracks the head pose and expression in a face sequence folder (as `face::make_sequence`
 writes: cameras, images, the neutral `model.obj` and `init.csv` with the first frame's pose
 and FAPs): the model is textured from the first frame, then each frame's pose is found by
 Gauss–Newton on the photometric error and its FAP values by simulated annealing. Writes
@@ -299,9 +301,10 @@ Returns #{frames, pose_err_deg, pose_err_max_deg, fap_err, fap_err_max (fraction
 FAP's range; () without ground truth), fps, files}.",
         |seq: &str, out: &str, m: Map| track(seq, out, &m)
     );
-    register!(
+    function!(
         engine,
-        "face_sliders",
+        "face::sliders",
+        alias = "face_sliders",
         ["Array"],
         "Names of the expression sliders of the generic face (the seed's interface sliders such
 as `Mouth width` or `Left eyelid`, then the six basic expressions `smile`, `surprise`, `anger`, `sadness`,
@@ -312,36 +315,40 @@ as `Mouth width` or `Left eyelid`, then the six basic expressions `smile`, `surp
             Ok(ex.names().into_iter().map(|n| Dynamic::from(n.to_string())).collect())
         }
     );
-    register!(
+    function!(
         engine,
-        "face_expression_png",
+        "face::expression_png",
+        alias = "face_expression_png",
         ["path: String", "values: Map", "()"],
         "Renders the generic face (MediaPipe canonical mesh with a procedural skin texture,
 shaded, frontal, 512×512) with an expression to a PNG: `values` maps slider names (see
-`face_sliders`) and MPEG-4 FAPs written `fap_N` (in FAP units: value / 1024 × FAPU) to their
+`face::sliders`) and MPEG-4 FAPs written `fap_N` (in FAP units: value / 1024 × FAPU) to their
 values, e.g. #{ smile: 1.0 } or #{ fap_3: 800 }.",
         |path: &str, m: Map| expression_png(path, &m, 0.0)
     );
-    register!(
+    function!(
         engine,
-        "face_expression_png",
+        "face::expression_png",
+        alias = "face_expression_png",
         ["path: String", "values: Map", "yaw_deg: f64", "()"],
-        "As `face_expression_png(path, values)`, seen from `yaw_deg` degrees to the side
+        "As `face::expression_png(path, values)`, seen from `yaw_deg` degrees to the side
 (positive: from the subject's left).",
         |path: &str, m: Map, yaw: f64| expression_png(path, &m, yaw)
     );
-    register!(
+    function!(
         engine,
-        "face_export_arkit",
+        "face::export_arkit",
+        alias = "face_export_arkit",
         ["path: String", "()"],
         "Writes the generic face as a glTF binary (.glb) with the 52 ARKit-style blendshapes as
 named morph targets (`extras.targetNames`, the names Blender, Unity and three.js read), made
 from the FAPs and muscles, and beside it a CSV of each shape's largest displacement.",
         |path: &str| arkit(path)
     );
-    register!(
+    function!(
         engine,
-        "face_fit",
+        "face::fit",
+        alias = "face_fit",
         ["images: String", "out: String", "options: Map", "Map"],
         "Adapts the generic face (MediaPipe canonical mesh) to the photos of folder `images` that
 have a `.pts` file of the same stem (68 iBUG landmarks, 300-W convention): each photo's
@@ -358,14 +365,15 @@ names, texture_coverage, mean_abs_change_mm, files}.",
         |images: &str, out: &str, m: Map| fit(images, out, &m)
     );
     engine.register_type_with_name::<FaceFitSession>("FaceFit");
-    register!(
+    function!(
         engine,
-        "face_fit_start",
+        "face::fit_start",
+        alias = "face_fit_start",
         ["images: String", "options: Map", "FaceFit"],
         "Starts a step-by-step adaptation of the generic face to the photos of `images` that have
 a `.pts` file of the same stem (option `pts`: the folder of the .pts files). Then call
 `calibrate`, `adapt_contours`, `deform` and `refine_cameras` in that order; `undo` returns to
-the state before the last step; `write` writes the outputs as `face_fit` does.",
+the state before the last step; `write` writes the outputs as `face::fit` does.",
         |images: &str, m: Map| start(images, &m)
     );
     register!(
@@ -435,7 +443,7 @@ eye corners); NaN before `calibrate`.",
         engine,
         "write",
         ["fit: FaceFit", "out: String", "Map"],
-        "Writes the outputs of the adaptation in its current state under `out` (as `face_fit`:
+        "Writes the outputs of the adaptation in its current state under `out` (as `face::fit`:
 textured OBJ and glb, overlays, renders, error map, fit.csv); returns #{images,
 landmark_err_iod_pct, texture_coverage, files}.",
         |s: &mut FaceFitSession, out: &str| -> RResult<Map> {

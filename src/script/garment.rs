@@ -1,15 +1,15 @@
 //! Script bindings for garments: pattern files (garment tables, JSON, SVG, DXF-AAMA) as a
-//! `Pattern` handle, and `dress`, which meshes, pre-positions and sews a pattern on the
+//! `Pattern` handle, and `garment::dress`, which meshes, pre-positions and sews a pattern on the
 //! mannequin into a `Simulation`.
 
 use std::path::Path;
 use std::sync::Arc;
 
-use rhai::{Engine, Map, INT};
+use rhai::{Map, INT};
 
 use super::convert::{count, num, rt_err, update_from_map, RResult};
 use super::kes::KesFabric;
-use super::{register, Fabric, SimHandle};
+use super::{function, modules::ApiBuilder, register, Fabric, SimHandle};
 use crate::body::Mannequin;
 use crate::cloth::{FabricParameters, MaterialLaw, SimulationParameters};
 use crate::garment::{dress, read_garment, read_pattern_json, read_pattern_svg, DressParameters};
@@ -42,7 +42,7 @@ fn read_any(path: &str) -> Result<Pattern, PatternError> {
     }
 }
 
-/// `dress` for both kinds of fabric: a linear one, or a density with a measured law.
+/// `garment::dress` for both kinds of fabric: a linear one, or a density with a measured law.
 fn dress_on_mannequin(
     pattern: &Pattern,
     fabric: FabricParameters,
@@ -80,9 +80,9 @@ fn dress_on_mannequin(
 }
 
 /// Registers the garment functions.
-pub fn register(engine: &mut Engine) {
+pub fn register(engine: &mut ApiBuilder) {
     engine.register_type_with_name::<PatternHandle>("Pattern");
-    register!(engine, "garment_pattern", ["path: String", "Pattern"],
+    function!(engine, "garment::pattern", alias = "garment_pattern", ["path: String", "Pattern"],
         "Reads a sewing pattern: a garment table (`*.garment.json`: an SVG, the parts used, folds,\npairs, placements and seams), a pattern in JSON, an SVG or a DXF-AAMA file. Pieces cut on the\nfold are unfolded and pairs doubled; the pattern is validated (closed, non-crossing outlines,\nmatching seam lengths) with errors naming file, piece and edge.",
         |path: &str| -> RResult<PatternHandle> { Ok(PatternHandle(Arc::new(read_any(path).map_err(perr)?))) });
     register!(
@@ -99,13 +99,13 @@ pub fn register(engine: &mut Engine) {
         "Number of seams.",
         |p: &mut PatternHandle| -> INT { p.0.seams.len() as INT }
     );
-    register!(engine, "dress", ["pattern: Pattern", "fabric: Fabric", "options: Map", "Simulation"],
+    function!(engine, "garment::dress", alias = "dress", ["pattern: Pattern", "fabric: Fabric", "options: Map", "Simulation"],
         "Meshes the pattern, pre-positions it around the MakeHuman mannequin at rest (no arrangement\npoints) and returns a simulation that sews it (seam threads shorten at `sewing_speed`, no\ngravity) and then drapes it, the mannequin as a collision body. Options: `makehuman` (dir,\ndefault `$EMILION_DATA/bodies/makehuman`), `dt` (s), and the `DressParameters` fields:\n`seam_stiffness` (N/m), `seam_max_force` (N), `sewing_speed` (m/s), `silhouette_cell` (m),\n`edge_length` (m, the mesh's target edge), `clearance` (m, kept from the skin) and\n`relax_levels` (levels of the pre-positioning's multi-resolution relaxation, 1 to 6, default 3).",
         |p: &mut PatternHandle, f: Fabric, m: Map| -> RResult<SimHandle> {
             dress_on_mannequin(&p.0, f.0, None, m)
         });
-    register!(engine, "dress", ["pattern: Pattern", "fabric: KesFabric", "options: Map", "Simulation"],
-        "As `dress` with a fabric file (`kes_fabric`): the garment takes the fabric's areal density\nand its material law from its measurements (KES parameters or curves, uncalibrated).",
+    function!(engine, "garment::dress", alias = "dress", ["pattern: Pattern", "fabric: KesFabric", "options: Map", "Simulation"],
+        "As `garment::dress` with a fabric file (`kes::fabric`): the garment takes the fabric's areal density\nand its material law from its measurements (KES parameters or curves, uncalibrated).",
         |p: &mut PatternHandle, f: KesFabric, m: Map| -> RResult<SimHandle> {
             let (params, law) = measured_fabric(&f.0).map_err(rt_err)?;
             dress_on_mannequin(&p.0, params, Some(Arc::new(law)), m)

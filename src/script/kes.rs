@@ -5,11 +5,11 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use rhai::{Array, Dynamic, Engine, Map};
+use rhai::{Array, Dynamic, Map};
 
 use super::convert::{num, rt_err, RResult};
 use super::fabric::Fabric;
-use super::register;
+use super::{function, modules::ApiBuilder, register};
 use crate::kes::calibrate::Tests;
 use crate::kes::damping::{fit_stretch_damping, free_oscillation, DecayExperiment};
 use crate::kes::lab::{self, FabricReport, LabOptions};
@@ -118,18 +118,19 @@ fn param_maps(r: &FabricReport) -> Array {
 }
 
 /// Registers the lab's functions.
-pub fn register(engine: &mut Engine) {
+pub fn register(engine: &mut ApiBuilder) {
     engine.register_type_with_name::<KesFabric>("KesFabric");
     engine.register_type_with_name::<KesReport>("KesReport");
 
-    register!(engine, "kes_fabric", ["path: String", "KesFabric"],
+    function!(engine, "kes::fabric", alias = "kes_fabric", ["path: String", "KesFabric"],
         "Reads a fabric file (format `emilion-fabric-1`, see kawabata/FORMAT.md). Errors name the\nfile and the field.",
         |path: &str| -> RResult<KesFabric> {
             Ok(KesFabric(Arc::new(read_fabric(Path::new(path)).map_err(rt_err)?)))
         });
-    register!(
+    function!(
         engine,
-        "kes_fabrics",
+        "kes::fabrics",
+        alias = "kes_fabrics",
         ["dir: String", "Array"],
         "Reads every `*.json` fabric file of a folder, sorted by name.",
         |dir: &str| -> RResult<Array> {
@@ -140,7 +141,7 @@ pub fn register(engine: &mut Engine) {
                 .collect())
         }
     );
-    register!(engine, "kes_import_wang", ["dir: String", "out_dir: String", "Array"],
+    function!(engine, "kes::import_wang", alias = "kes_import_wang", ["dir: String", "out_dir: String", "Array"],
         "Converts the Wang 2011 (ARCSim) material files of `dir` into fabric files in `out_dir`;\nreturns the written paths. (Their licence forbids redistribution: convert at run time.)",
         |dir: &str, out: &str| -> RResult<Array> {
             Ok(paths(wang::import_wang_dir(Path::new(dir), Path::new(out)).map_err(rt_err)?))
@@ -163,7 +164,7 @@ pub fn register(engine: &mut Engine) {
         )
     );
 
-    register!(engine, "kes_lab", ["fabric: KesFabric", "options: Map", "KesReport"],
+    function!(engine, "kes::lab", alias = "kes_lab", ["fabric: KesFabric", "options: Map", "KesReport"],
         "Runs the virtual Kawabata lab on a fabric: fits the law to its KES parameters (if any),\nruns the rigs and compares. Options: `meshes` (\"coarse\", \"fine\"), `fit` (bool),\n`cantilever` (bool), `tests` (\"tensile\", \"shear\", \"bending\"); defaults: both meshes,\nfit, cantilever, every test.",
         |f: KesFabric, opts: Map| -> RResult<KesReport> {
             let o = options(&opts)?;
@@ -209,7 +210,7 @@ pub fn register(engine: &mut Engine) {
         |r: &mut KesReport, dir: &str| -> RResult<Array> {
             Ok(paths(lab::write_fabric_outputs(&r.0, Path::new(dir)).map_err(rt_err)?))
         });
-    register!(engine, "kes_summary", ["reports: Array", "dir: String", "Map"],
+    function!(engine, "kes::summary", alias = "kes_summary", ["reports: Array", "dir: String", "Map"],
         "Writes `summary.csv` and `summary.md` (measured vs simulated parameters, curve errors,\ncantilever) for a list of reports; returns #{csv, md, worst_curve_rms_pct,\nworst_param_err_pct, fabrics}.",
         |reports: Array, dir: &str| -> RResult<Map> {
             let rs: Vec<FabricReport> = reports
@@ -229,7 +230,7 @@ pub fn register(engine: &mut Engine) {
             m.insert("fabrics".into(), (rs.len() as rhai::INT).into());
             Ok(m)
         });
-    register!(engine, "free_oscillation", ["fabric: Fabric", "Map"],
+    function!(engine, "kes::free_oscillation", alias = "free_oscillation", ["fabric: Fabric", "Map"],
         "Free axial oscillation of a 20 cm strip stretched 1 % and released (explicit\nintegrator): #{log_decrement, period, peaks}.",
         |f: Fabric| -> RResult<Map> {
             let d = free_oscillation(f.0, Arc::new(f.0.linear_law()), DecayExperiment::default())?;
@@ -239,7 +240,7 @@ pub fn register(engine: &mut Engine) {
             m.insert("peaks".into(), d.peaks.iter().map(|&p| Dynamic::from(p)).collect::<Array>().into());
             Ok(m)
         });
-    register!(engine, "fit_damping", ["fabric: Fabric", "log_decrement: float", "Map"],
+    function!(engine, "kes::fit_damping", alias = "fit_damping", ["fabric: Fabric", "log_decrement: float", "Map"],
         "Fits the stiffness-proportional damping (`stretch_damping`, s) so that the free\noscillation decays with the given logarithmic decrement: #{stretch_damping,\nlog_decrement, period}.",
         |f: Fabric, target: Dynamic| -> RResult<Map> {
             let target = num(&target, "log_decrement")?;

@@ -3,10 +3,10 @@
 
 use std::path::Path;
 
-use rhai::{Array, Dynamic, Engine, Map, INT};
+use rhai::{Array, Dynamic, Map, INT};
 
 use super::convert::{finite, index, non_negative, rt_err, RResult};
-use super::{register, SimHandle};
+use super::{function, modules::ApiBuilder, register, SimHandle};
 use crate::cloth::buckling::wrinkles::{compressed_springs, energy_parts, wrinkles_along};
 use crate::geometry::Vec3;
 use crate::render::plot::{write_plot_pair, write_series_csv, PlotSpec, Series, SeriesStyle};
@@ -24,7 +24,7 @@ fn floats(a: &Dynamic, what: &str) -> RResult<Vec<f64>> {
 }
 
 /// Registers the measuring and plotting functions.
-pub fn register(engine: &mut Engine) {
+pub fn register(engine: &mut ApiBuilder) {
     register!(engine, "compression", ["sim: Simulation", "strain: float", "Map"],
         "Stretch springs compressed by more than `strain` (e.g. 0.01) now: #{springs, compressed,\nfraction}. A cloth without a buckling model pushed in its plane stays compressed.",
         |h: &mut SimHandle, strain: Dynamic| -> RResult<Map> {
@@ -78,7 +78,7 @@ pub fn register(engine: &mut Engine) {
             m.insert("amplitude".into(), Dynamic::from_float(w.amplitude));
             Ok(m)
         });
-    register!(engine, "plot", ["stem: String", "spec: Map", "Array"],
+    function!(engine, "plot::lines", alias = "plot", ["stem: String", "spec: Map", "Array"],
         "Writes a line plot as `stem`.png, `stem`.svg and `stem`.csv from\n#{title, x_label, y_label, series: [#{name, x: [..], y: [..], style: \"solid\" | \"dashed\" |\n\"markers\"}]}; returns the paths written.",
         |stem: &str, spec: Map| -> RResult<Array> {
             let text = |k: &str| -> RResult<String> {

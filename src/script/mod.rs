@@ -2,8 +2,12 @@
 //! [`Engine`] and owns nothing else. Scripts build fabrics, cloths and simulations, run them
 //! and write meshes, statistics and pictures; all numeric work stays in Rust.
 //!
+//! Free functions live in static modules by domain (`cloth::grid`, `kes::lab`, `face::fit`, …;
+//! see [`modules`]), methods and properties of the handles stay global (`sim.run(…)`).
+//!
+//! - [`modules`]: the modules, the builder that collects them, the old names kept as aliases;
 //! - [`convert`]: error conversion, numbers and vectors, `…Parameters` ⇄ object maps;
-//! - [`fabric`]: the `Fabric` value type and the `Cloth` handle (`fabric()`, `cloth_grid`, …);
+//! - [`fabric`]: the `Fabric` value type and the `Cloth` handle (`cloth::fabric()`, `cloth::grid`, …);
 //! - [`sim`]: the `Simulation` handle: constraints, stepping, runs with per-frame callbacks;
 //! - [`contact`]: collision bodies, the mannequin, friction, contact settings and read-outs;
 //! - [`output`]: positions, bounds, energies, OBJ/glTF/CSV/JSON/PNG output;
@@ -24,6 +28,7 @@ pub mod face;
 pub mod garment;
 pub mod kes;
 pub mod measure;
+pub mod modules;
 pub mod output;
 pub mod repl;
 pub mod run;
@@ -33,12 +38,15 @@ pub mod tracking_sequence;
 
 use rhai::{Dynamic, Engine};
 
+use modules::ApiBuilder;
+
 pub use fabric::{ClothHandle, Fabric};
 pub use run::{run_file, ScriptError};
 pub use sim::SimHandle;
 
-/// Registers a documented global function: name, parameter infos (the last one is the
-/// return type), doc text (plain lines, turned into `///` comments) and the closure.
+/// Registers a documented global function (a method or property of a handle): name, parameter
+/// infos (the last one is the return type), doc text (plain lines, turned into `///` comments)
+/// and the closure.
 macro_rules! register {
     ($engine:expr, $name:expr, [$($p:expr),* $(,)?], $doc:expr, $f:expr) => {
         rhai::FuncRegistration::new($name)
@@ -57,7 +65,33 @@ macro_rules! getter {
             .register_into_engine($engine, $f)
     };
 }
-pub(crate) use {getter, register};
+/// Registers a documented free function `module::name` into its module of the
+/// [`ApiBuilder`](modules::ApiBuilder) (parameter infos and doc as for `register!`); with
+/// `alias = "old_name"`, also registers the old flat name globally, documented as an alias kept
+/// for one release.
+macro_rules! function {
+    ($engine:expr, $path:literal, alias = $alias:literal, [$($p:expr),* $(,)?], $doc:expr, $f:expr) => {{
+        let f = $f;
+        $crate::script::function!($engine, $path, [$($p),*], $doc, f.clone());
+        rhai::FuncRegistration::new($alias)
+            .with_params_info::<&str>([$($p),*])
+            .with_comments([$crate::script::convert::doc_comment(
+                &$crate::script::modules::alias_doc($path),
+            )])
+            .register_into_engine($engine, f)
+    }};
+    ($engine:expr, $path:literal, [$($p:expr),* $(,)?], $doc:expr, $f:expr) => {{
+        let (module, name) = $path
+            .split_once("::")
+            .expect("a module function is named `module::name`");
+        rhai::FuncRegistration::new(name)
+            .with_namespace(rhai::FnNamespace::Internal)
+            .with_params_info::<&str>([$($p),*])
+            .with_comments([$crate::script::convert::doc_comment($doc)])
+            .set_into_module($engine.module(module), $f)
+    }};
+}
+pub(crate) use {function, getter, register};
 
 /// Limits that keep a runaway script from hanging or exhausting memory.
 #[derive(Debug, Clone, Copy)]
@@ -97,7 +131,7 @@ pub fn build_engine() -> Engine {
 /// An engine with every emilion function registered and the given limits. `print` goes to
 /// stdout, `debug` to stderr.
 pub fn build_engine_with(limits: EngineLimits) -> Engine {
-    let mut engine = Engine::new();
+    let mut engine = ApiBuilder::new(Engine::new());
     engine
         .set_max_operations(limits.max_operations)
         .set_max_expr_depths(limits.max_expr_depths.0, limits.max_expr_depths.1)
@@ -122,7 +156,7 @@ pub fn build_engine_with(limits: EngineLimits) -> Engine {
     face::register(&mut engine);
     tracking_sequence::register(&mut engine);
     kes::register(&mut engine);
-    engine
+    engine.finish()
 }
 
 /// A human-readable rendering of a script value (handles print their summary).
@@ -143,7 +177,8 @@ pub fn describe(v: &Dynamic) -> String {
 }
 
 /// Names of the functions registered by emilion (not rhai's standard library), sorted and
-/// deduplicated; property accessors appear as `get$prop` / `set$prop`.
+/// deduplicated; module functions appear as `module::name`, property accessors as
+/// `get$prop` / `set$prop`.
 pub fn function_names(engine: &Engine) -> Vec<String> {
     let mut names: Vec<String> = engine
         .gen_fn_signatures(false)

@@ -1,6 +1,6 @@
 //! The interactive loop: a rustyline editor with history (`~/.emilion_history`), multi-line
 //! input (a trailing `\` or unbalanced brackets continue with `...> `), tab completion of the
-//! registered function names, and one persistent Scope. Results print as `=> value`; errors
+//! registered function names (`module::name` included), and one persistent Scope. Results print as `=> value`; errors
 //! print and the loop goes on. On a non-terminal stdin it reads plain lines, without prompts.
 
 use std::io::{BufRead, IsTerminal, Write};
@@ -25,6 +25,22 @@ struct ReplHelper {
     names: Vec<String>,
 }
 
+/// The completions of the word that ends at `pos` in `line`: where the word starts and the
+/// `names` it begins. A word may hold a module path, so `cloth::g` completes to `cloth::grid`
+/// and `clo` to `cloth::…` as well as `cloth_…`.
+pub fn completions(names: &[String], line: &str, pos: usize) -> (usize, Vec<String>) {
+    let start = line[..pos]
+        .rfind(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':'))
+        .map_or(0, |i| i + 1);
+    let word = &line[start..pos];
+    let found = names
+        .iter()
+        .filter(|n| !word.is_empty() && n.starts_with(word))
+        .cloned()
+        .collect();
+    (start, found)
+}
+
 impl Completer for ReplHelper {
     type Candidate = String;
     fn complete(
@@ -33,17 +49,7 @@ impl Completer for ReplHelper {
         pos: usize,
         _: &Context<'_>,
     ) -> rustyline::Result<(usize, Vec<String>)> {
-        let start = line[..pos]
-            .rfind(|c: char| !(c.is_alphanumeric() || c == '_'))
-            .map_or(0, |i| i + 1);
-        let word = &line[start..pos];
-        let found = self
-            .names
-            .iter()
-            .filter(|n| !word.is_empty() && n.starts_with(word))
-            .cloned()
-            .collect();
-        Ok((start, found))
+        Ok(completions(&self.names, line, pos))
     }
 }
 impl Hinter for ReplHelper {
@@ -129,7 +135,7 @@ impl Session {
             "" => return Flow::Continue,
             "quit" | "exit" => return Flow::Quit,
             "help" => {
-                let _ = writeln!(out, "Type Rhai code; `help NAME` shows the docs of the functions whose name starts with NAME;\n`quit` or `exit` leaves. Functions:");
+                let _ = writeln!(out, "Type Rhai code; `help NAME` shows the docs of the functions whose name starts with NAME\n(`help cloth::` for a module); `quit` or `exit` leaves. Functions:");
                 let _ = write!(out, "{}", docs::help_text(&self.engine, ""));
                 return Flow::Continue;
             }
@@ -254,4 +260,24 @@ fn push_line(buf: &mut String, line: &str) {
     }
     buf.push_str(line);
     buf.push('\n');
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn module_paths_complete() {
+        let mut names = function_names(&build_engine());
+        names.retain(|n| !n.contains('$'));
+        let line = "let c = cloth::gr";
+        let (start, found) = completions(&names, line, line.len());
+        assert_eq!(start, "let c = ".len());
+        assert_eq!(found, ["cloth::grid"]);
+        let (_, found) = completions(&names, "kes::", 5);
+        assert!(found.contains(&"kes::lab".to_string()), "{found:?}");
+        assert!(found.iter().all(|n| n.starts_with("kes::")), "{found:?}");
+        let (_, found) = completions(&names, "x = cloth_g", 11);
+        assert_eq!(found, ["cloth_grid"], "the old names still complete");
+    }
 }

@@ -7,12 +7,12 @@ use std::fmt;
 use std::io::IsTerminal;
 
 use indicatif::ProgressBar;
-use rhai::{Array, Dynamic, Engine, FnPtr, Locked, Map, NativeCallContext, Shared, INT};
+use rhai::{Array, Dynamic, FnPtr, Locked, Map, NativeCallContext, Shared, INT};
 
 use super::convert::{
     count, finite, get_field, indices, rt_err, to_map, update_field, update_from_map, vec3, RResult,
 };
-use super::{getter, register, ClothHandle};
+use super::{function, getter, modules::ApiBuilder, register, ClothHandle};
 use crate::cloth::{Simulation, SimulationParameters, Trajectory};
 use crate::contact::{Floor, SimulationContact};
 
@@ -170,8 +170,8 @@ fn run_n(h: &SimHandle, n: u64) -> RResult<()> {
     Ok(())
 }
 
-/// Registers `simulation` and the `Simulation` methods for constraints and stepping.
-pub fn register(engine: &mut Engine) {
+/// Registers `cloth::simulation` and the `Simulation` methods for constraints and stepping.
+pub fn register(engine: &mut ApiBuilder) {
     engine.register_type_with_name::<SimHandle>("Simulation");
     let new_sim = |c: &ClothHandle, m: &Map| -> RResult<SimHandle> {
         let params = update_from_map(&SimulationParameters::default(), m, "simulation")?;
@@ -179,10 +179,10 @@ pub fn register(engine: &mut Engine) {
         sim.add_contact();
         Ok(SimHandle::new(sim))
     };
-    register!(engine, "simulation", ["cloth: Cloth", "Simulation"],
+    function!(engine, "cloth::simulation", alias = "simulation", ["cloth: Cloth", "Simulation"],
         "A simulation of `cloth` at rest, with default settings (dt 1/120 s, implicit, gravity −9.81 z).",
         move |c: ClothHandle| new_sim(&c, &Map::new()));
-    register!(engine, "simulation", ["cloth: Cloth", "params: Map", "Simulation"],
+    function!(engine, "cloth::simulation", alias = "simulation", ["cloth: Cloth", "params: Map", "Simulation"],
         "A simulation of `cloth` with settings from a map: dt, integrator (\"implicit\" | \"explicit\"),\ngravity [x, y, z], cg_tolerance, cg_max_iterations, warm_start, explicit_substeps, max_speed.",
         move |c: ClothHandle, m: Map| new_sim(&c, &m));
 

@@ -4,10 +4,10 @@ use std::io::IsTerminal;
 use std::path::Path;
 
 use indicatif::ProgressBar;
-use rhai::{Dynamic, Engine, Map, INT};
+use rhai::{Dynamic, Map, INT};
 
 use super::convert::{count, finite, rt_err, RResult};
-use super::register;
+use super::{function, modules::ApiBuilder};
 use crate::body::Mannequin;
 use crate::geometry::files::data_path;
 use crate::tracking::sequence_files::Sequence;
@@ -128,12 +128,13 @@ fn track(seq_dir: &str, out: &str, m: &Map) -> RResult<Map> {
 }
 
 /// Registers the tracker's script functions.
-pub fn register(engine: &mut Engine) {
-    register!(
+pub fn register(engine: &mut ApiBuilder) {
+    function!(
         engine,
-        "track_body",
+        "track::body",
+        alias = "track_body",
         ["seq: String", "out: String", "Map"],
-        "Tracks the body in a sequence folder (the layout `make_sequence` writes: cameras,
+        "Tracks the body in a sequence folder (the layout `track::make_sequence` writes: cameras,
 images per camera, `init_joints.csv` with an approximate first pose, and
 `ground_truth.csv` when known) by analysis-by-synthesis: the textured puppet rendered into
 every camera, its joint angles found frame by frame by annealing. Writes under `out`: the
@@ -143,11 +144,12 @@ Returns #{frames, mpjpe_mm, max_frame_mm, arm_mm (elbows and wrists; () without 
 truth), s_per_frame, stage_seconds (per frame), start_seconds, files}.",
         |seq: &str, out: &str| track(seq, out, &Map::new())
     );
-    register!(
+    function!(
         engine,
-        "track_body",
+        "track::body",
+        alias = "track_body",
         ["seq: String", "out: String", "options: Map", "Map"],
-        "As `track_body(seq, out)` with options: `particles` per layer, `layers` (pyramid level
+        "As `track::body(seq, out)` with options: `particles` per layer, `layers` (pyramid level
 of each annealing layer, coarse first, e.g. [1, 1, 1, 0, 0]), `robust_sigma` (grey levels),
 `mesh_cell` (metres), `lbs` (linear blend skinning instead of rigid), `background_frames`,
 `prediction` (velocity factor), `prior_weight` (motion prior per squared move spread,

@@ -1,14 +1,14 @@
-//! Script bindings of the synthetic multi-camera sequences: `make_sequence`.
+//! Script bindings of the synthetic multi-camera sequences: `track::make_sequence`.
 
 use std::path::Path;
 
-use rhai::{Dynamic, Engine, Map, FLOAT, INT};
+use rhai::{Dynamic, Map, FLOAT, INT};
 
 use super::convert::{rt_err, RResult};
-use super::register;
+use super::{function, modules::ApiBuilder};
 use crate::tracking::sequence::{make_sequence, SequenceOptions, SequenceSummary};
 
-/// Option keys of `make_sequence(motion, out, options)`.
+/// Option keys of `track::make_sequence(motion, out, options)`.
 const KEYS: [&str; 14] = [
     "cameras",
     "width",
@@ -143,11 +143,12 @@ fn run(motion: &str, out: &str, o: &SequenceOptions) -> RResult<Map> {
     Ok(summary_map(&s))
 }
 
-/// Registers `make_sequence`.
-pub fn register(engine: &mut Engine) {
-    register!(
+/// Registers `track::make_sequence`.
+pub fn register(engine: &mut ApiBuilder) {
+    function!(
         engine,
-        "make_sequence",
+        "track::make_sequence",
+        alias = "make_sequence",
         ["motion: String", "out: String", "Map"],
         "Makes a synthetic multi-camera sequence of a BVH clip into folder `out`: the MakeHuman
 mannequin in clothes-like colours, on a treadmill, filmed by 4 cameras on a ring (320×240,
@@ -157,11 +158,12 @@ image, changing light and sensor noise. Writes `sequence.json`, `cameras/camN.js
 Returns #{frames, cameras, width, height, seconds, seconds_per_frame, dir}.",
         |motion: &str, out: &str| run(motion, out, &SequenceOptions::default())
     );
-    register!(
+    function!(
         engine,
-        "make_sequence",
+        "track::make_sequence",
+        alias = "make_sequence",
         ["motion: String", "out: String", "options: Map", "Map"],
-        "As `make_sequence(motion, out)` with options (numbers may be given as strings):
+        "As `track::make_sequence(motion, out)` with options (numbers may be given as strings):
 `cameras` (1–64), `width`, `height` (pixels), `fps`, `frames` (default: the whole clip),
 `start` (clip time of frame 0, s), `noise` (Gaussian sigma, grey levels, default 4),
 `lighting` (amplitude of the light changes, default 0.15), `occluder` (fraction of each
