@@ -123,7 +123,7 @@ fn blurred(v: Vec<f64>) -> Vec<f64> {
         height: GRID as u32,
         data: v,
     };
-    box_mean_3x3(grid).data
+    box_mean_3x3(&grid).data
 }
 
 /// Squared correlation of `a` and `b` (0 when either is flat).

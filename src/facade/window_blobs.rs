@@ -1,14 +1,14 @@
 //! Windows found as dark blobs of the rectified facade: a pixel belongs to a window candidate
 //! when it is darker than its neighbourhood (glass shows the unlit inside), candidates are the
 //! four-connected pieces of such pixels whose bounding box has a window's size, shape and
-//! fill, and a candidate is kept only when another one of about its size stands in its row or its
-//! column (windows repeat: Müller et al.'s prior, without asking for one global lattice, which
-//! street photos of several buildings break), when its outline is a sharp step (a frame) and
-//! when it stands above the ground floor. The parameters were chosen on the tuning half of
+//! fill, and a candidate is kept only when another one of about its size stands in its row or
+//! its column (windows repeat: Müller et al.'s prior, without asking for one global lattice,
+//! which street photos of several buildings break), when its outline is a sharp step (a frame)
+//! and when it stands above the ground floor. The parameters were chosen on the tuning half of
 //! the labelled photos (`scripts/facades_eval.rhai --set half=tune`).
 
 use super::rect::Rect;
-use crate::geometry::image::filters::integral_images;
+use crate::geometry::image::filters::integral_image;
 use crate::geometry::image::{components, Connectivity, Gray};
 
 /// Parameters of the detector (fractions are of the facade region).
@@ -67,15 +67,16 @@ pub fn dark_pixels(img: &Gray, region: &Rect, p: &BlobParams) -> Vec<bool> {
     let side = (region.x1 - region.x0).max(region.y1 - region.y0) as f64;
     let r = ((p.scale * side) as usize).max(3);
     let g = |i: usize| img.data[i] as f64;
-    let (s1, s2) = integral_images(img);
+    let s1 = integral_image((0..w * h).map(g), w, h);
+    let s2 = integral_image((0..w * h).map(|i| g(i) * g(i)), w, h);
     let mut dark = vec![false; w * h];
     for y in region.y0 as usize..region.y1 as usize {
         let (ya, yb) = (y.saturating_sub(r), (y + r + 1).min(h));
         for x in region.x0 as usize..region.x1 as usize {
             let (xa, xb) = (x.saturating_sub(r), (x + r + 1).min(w));
-            let sum = |s: &[u64]| {
-                let at = |y: usize, x: usize| s[y * (w + 1) + x] as f64;
-                at(yb, xb) - at(ya, xb) - at(yb, xa) + at(ya, xa)
+            let sum = |s: &[f64]| {
+                s[yb * (w + 1) + xb] - s[ya * (w + 1) + xb] - s[yb * (w + 1) + xa]
+                    + s[ya * (w + 1) + xa]
             };
             let n = ((yb - ya) * (xb - xa)) as f64;
             let mean = sum(&s1) / n;

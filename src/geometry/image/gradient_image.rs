@@ -44,7 +44,7 @@ impl GradientImage {
 
     fn smooth_and_differentiate(&mut self, sigma: f64) {
         if sigma >= 0.3 {
-            self.value = gaussian_blur(std::mem::take(&mut self.value), sigma);
+            self.value = gaussian_blur(&self.value, sigma);
         }
         central_differences(&self.value, &mut self.gx, &mut self.gy);
     }
@@ -61,38 +61,44 @@ impl GradientImage {
         self.value.height as usize
     }
 
-    /// Bilinear value and gradient at pixel coordinates `(x, y)` (the centre of the top-left
-    /// pixel is `(0, 0)`); `None` outside the image (one pixel of margin).
+    /// The top-left pixel of the cell holding `(x, y)` and the fractions across it; `None`
+    /// outside the image (one pixel of margin).
     #[inline]
-    pub fn sample(&self, x: f64, y: f64) -> Option<(f32, f32, f32)> {
+    fn cell(&self, x: f64, y: f64) -> Option<(usize, f32, f32)> {
         let w = self.width();
         if !(x >= 0.0 && y >= 0.0 && x < (w - 1) as f64 && y < (self.height() - 1) as f64) {
             return None;
         }
         let (x0, y0) = (x as usize, y as usize);
         let (fx, fy) = ((x - x0 as f64) as f32, (y - y0 as f64) as f32);
-        let i = y0 * w + x0;
-        let lerp = |b: &[f32]| {
-            let top = b[i] + (b[i + 1] - b[i]) * fx;
-            let bottom = b[i + w] + (b[i + w + 1] - b[i + w]) * fx;
-            top + (bottom - top) * fy
-        };
-        Some((lerp(&self.value.data), lerp(&self.gx), lerp(&self.gy)))
+        Some((y0 * w + x0, fx, fy))
+    }
+
+    /// Bilinear interpolation of `b` (row-major as this image) in the cell of [`Self::cell`].
+    #[inline]
+    fn lerp(&self, b: &[f32], (i, fx, fy): (usize, f32, f32)) -> f32 {
+        let w = self.width();
+        let top = b[i] + (b[i + 1] - b[i]) * fx;
+        let bottom = b[i + w] + (b[i + w + 1] - b[i + w]) * fx;
+        top + (bottom - top) * fy
+    }
+
+    /// Bilinear value and gradient at pixel coordinates `(x, y)` (the centre of the top-left
+    /// pixel is `(0, 0)`); `None` outside the image (one pixel of margin).
+    #[inline]
+    pub fn sample(&self, x: f64, y: f64) -> Option<(f32, f32, f32)> {
+        let c = self.cell(x, y)?;
+        Some((
+            self.lerp(&self.value.data, c),
+            self.lerp(&self.gx, c),
+            self.lerp(&self.gy, c),
+        ))
     }
 
     /// Bilinear value only.
     #[inline]
     pub fn value_at(&self, x: f64, y: f64) -> Option<f32> {
-        let w = self.width();
-        if !(x >= 0.0 && y >= 0.0 && x < (w - 1) as f64 && y < (self.height() - 1) as f64) {
-            return None;
-        }
-        let (x0, y0) = (x as usize, y as usize);
-        let (fx, fy) = ((x - x0 as f64) as f32, (y - y0 as f64) as f32);
-        let i = y0 * w + x0;
-        let b = &self.value.data;
-        let top = b[i] + (b[i + 1] - b[i]) * fx;
-        let bottom = b[i + w] + (b[i + w + 1] - b[i + w]) * fx;
-        Some(top + (bottom - top) * fy)
+        let c = self.cell(x, y)?;
+        Some(self.lerp(&self.value.data, c))
     }
 }

@@ -1,11 +1,10 @@
 //! Grey images: one type, [`Gray`], row-major pixels of any channel type — 8-bit luma as the
 //! facade pipeline reads photos (rounded Rec. 601), float luma as photometric fitting smooths
-//! and samples it — with reading photos, luma, synthetic pictures and bilinear samples, and
-//! the conversion to and from `image`'s buffers that the `imageproc` filters take.
+//! and samples it — with reading photos, luma, synthetic pictures and bilinear samples.
 
 use std::path::Path;
 
-use image::{ImageBuffer, Luma, Primitive, RgbImage};
+use image::RgbImage;
 
 use crate::geometry::{GeometryError, Lcg64};
 
@@ -25,24 +24,6 @@ impl<T: Copy> Gray<T> {
     #[inline]
     pub fn at(&self, x: u32, y: u32) -> T {
         self.data[y as usize * self.width as usize + x as usize]
-    }
-}
-
-impl<T: Primitive> Gray<T> {
-    /// This image as an `image` buffer (no copy), for the `imageproc` filters.
-    pub fn into_buffer(self) -> ImageBuffer<Luma<T>, Vec<T>> {
-        ImageBuffer::from_raw(self.width, self.height, self.data)
-            .expect("a grey image holds width × height pixels")
-    }
-
-    /// The image of an `image` buffer (no copy).
-    pub fn from_buffer(buffer: ImageBuffer<Luma<T>, Vec<T>>) -> Self {
-        let (width, height) = buffer.dimensions();
-        Gray {
-            width,
-            height,
-            data: buffer.into_raw(),
-        }
     }
 }
 

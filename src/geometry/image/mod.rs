@@ -2,8 +2,9 @@
 //! or float), the float grey image with its gradients that photometric fitting samples
 //! ([`GradientImage`]), linear filters (blurs, box mean, Sobel and central-difference
 //! gradients, 2×2 downsampling: [`filters`]), binary morphology ([`morphology`]) and connected
-//! components ([`components`]). Filters run on `imageproc` where it gives the same numbers as
-//! the kernels the modules had; the others are written here once.
+//! components ([`components`](mod@components)). Each is written once here, as the vision
+//! modules had it, so their figures stay the same (`imageproc` was measured against each: see
+//! the modules).
 
 pub mod components;
 pub mod filters;
