@@ -237,7 +237,9 @@ fn check_glb_mesh(mesh: &GlbMesh) -> Result<(), String> {
             mesh.indices[i]
         ));
     }
-    let whole = |r: &Range<usize>| !r.is_empty() && r.len() % 3 == 0 && r.end <= mesh.indices.len();
+    let whole = |r: &Range<usize>| {
+        !r.is_empty() && r.len().is_multiple_of(3) && r.end <= mesh.indices.len()
+    };
     if let Some(k) = mesh.primitives.iter().position(|p| !whole(&p.indices)) {
         return Err(format!(
             "primitive {k} has indices {:?} of {}: not whole triangles",
