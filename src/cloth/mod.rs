@@ -21,6 +21,7 @@ pub mod multigrid;
 pub mod parallel;
 pub mod pcg;
 pub mod sewing;
+pub mod simd;
 pub mod simulation;
 pub mod state;
 pub mod stats;
