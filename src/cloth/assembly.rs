@@ -15,6 +15,7 @@ use super::elements::{BendLine, SpringKind};
 use super::material::Direction;
 use super::model::ClothModel;
 use super::parallel::{chunks, ordered_sum, stream_copy, stream_fence, SyncPtr, CHUNK};
+use super::simd::multiversion;
 use crate::geometry::{Mat3, Vec3};
 
 /// One matrix contribution: `values[slot] += scale · block src`, the scale kept apart (see
@@ -240,7 +241,8 @@ impl Assembly {
         energy
     }
 
-    fn element_pass(
+    multiversion! {
+    fn element_pass / element_pass_avx2(
         &mut self,
         model: &ClothModel,
         x: &[Vec3],
@@ -571,8 +573,10 @@ impl Assembly {
             + hinge_e
             + arc_e
     }
+    }
 
-    fn gather_pass(&mut self, model: &ClothModel, v: &[Vec3], inp: AssemblyInputs) {
+    multiversion! {
+    fn gather_pass / gather_pass_avx2(&mut self, model: &ClothModel, v: &[Vec3], inp: AssemblyInputs) {
         let n = model.particle_count();
         let drag = model.fabric.air_drag;
         let h = inp.dt;
@@ -701,6 +705,7 @@ impl Assembly {
                 stream_fence();
             });
         debug_assert_eq!(self.b.len(), n);
+    }
     }
 }
 

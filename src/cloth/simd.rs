@@ -57,8 +57,9 @@ fn cpu_has_avx2_fma() -> bool {
 /// for the wider registers too, so a whole loop nest handed to a parallel loop is vectorised;
 /// what it calls that does not inline runs generic.
 ///
-/// The function may not be generic or a method, and its parameters must be plain names: write
-/// the kernel as a free function taking the data it needs.
+/// The function may not be generic and its parameters must be plain names. A method (taking
+/// `&self` or `&mut self`) names its AVX2 twin after a slash, `fn name / name_avx2(&self, ..)`:
+/// the twin is a private method of the same type.
 ///
 /// ```ignore
 /// multiversion! {
@@ -89,6 +90,44 @@ macro_rules! multiversion {
             }
             $body
         }
+    };
+    (
+        $(#[$attr:meta])*
+        $vis:vis fn $name:ident / $fast:ident(&mut $s:ident $(, $arg:ident: $ty:ty)* $(,)?)
+        $(-> $ret:ty)? $body:block
+    ) => {
+        $(#[$attr])*
+        $vis fn $name(&mut $s $(, $arg: $ty)*) $(-> $ret)? {
+            #[cfg(target_arch = "x86_64")]
+            if $crate::cloth::simd::avx2_fma() {
+                // SAFETY: the CPU has AVX2 and FMA (checked at run time).
+                return unsafe { $s.$fast($($arg),*) };
+            }
+            $body
+        }
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx2,fma")]
+        #[allow(clippy::too_many_arguments)]
+        fn $fast(&mut $s $(, $arg: $ty)*) $(-> $ret)? $body
+    };
+    (
+        $(#[$attr:meta])*
+        $vis:vis fn $name:ident / $fast:ident(&$s:ident $(, $arg:ident: $ty:ty)* $(,)?)
+        $(-> $ret:ty)? $body:block
+    ) => {
+        $(#[$attr])*
+        $vis fn $name(&$s $(, $arg: $ty)*) $(-> $ret)? {
+            #[cfg(target_arch = "x86_64")]
+            if $crate::cloth::simd::avx2_fma() {
+                // SAFETY: the CPU has AVX2 and FMA (checked at run time).
+                return unsafe { $s.$fast($($arg),*) };
+            }
+            $body
+        }
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx2,fma")]
+        #[allow(clippy::too_many_arguments)]
+        fn $fast(&$s $(, $arg: $ty)*) $(-> $ret)? $body
     };
 }
 pub(crate) use multiversion;
