@@ -576,7 +576,12 @@ impl Assembly {
     }
 
     multiversion! {
-    fn gather_pass / gather_pass_avx2(&mut self, model: &ClothModel, v: &[Vec3], inp: AssemblyInputs) {
+    fn gather_pass / gather_pass_avx2(
+        &mut self,
+        model: &ClothModel,
+        v: &[Vec3],
+        inp: AssemblyInputs,
+    ) {
         let n = model.particle_count();
         let drag = model.fabric.air_drag;
         let h = inp.dt;
