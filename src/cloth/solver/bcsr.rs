@@ -94,6 +94,28 @@ pub struct Rows32<'a> {
     pub stencil: &'a [i32],
 }
 
+/// The body of [`Rows32::row_times_ptr`] with the row product `$kernel` (an unsafe function
+/// like [`sym_row_product`]), so that each form inlines its own.
+macro_rules! row_product {
+    ($rows:expr, $p:expr, $x:expr, $kernel:ident) => {{
+        let (rows, p, x) = ($rows, $p, $x);
+        let (s, e) = (rows.start[p], rows.start[p + 1]);
+        let values = &rows.values[s..e];
+        if e - s == rows.stencil.len() {
+            // the columns of a full row are p + the stencil's offsets (checked when the
+            // stencil was found): 13 fewer words per row to stream at every product
+            let cols = rows
+                .stencil
+                .iter()
+                .map(|&o| (p as isize + o as isize) as usize);
+            $kernel(values, cols, x)
+        } else {
+            let cols = rows.cols[s..e].iter().map(|&c| c as usize);
+            $kernel(values, cols, x)
+        }
+    }};
+}
+
 impl Rows32<'_> {
     /// Index of block (stored row `p`, column `j`), if it is in the pattern (a linear search:
     /// the permuted copy's columns are not sorted).
@@ -113,22 +135,24 @@ impl Rows32<'_> {
     /// entries this row reads.
     #[inline]
     pub unsafe fn row_times_ptr(&self, p: usize, x: *const Vec3) -> Vec3 {
-        let (s, e) = (self.start[p], self.start[p + 1]);
-        let values = &self.values[s..e];
-        if e - s == self.stencil.len() {
-            // the columns of a full row are p + the stencil's offsets (checked when the
-            // stencil was found): 13 fewer words per row to stream at every product
-            let cols = self
-                .stencil
-                .iter()
-                .map(|&o| (p as isize + o as isize) as usize);
-            // SAFETY: forwarded from the caller; the columns are the row's own.
-            unsafe { sym_row_product(values, cols, x) }
-        } else {
-            let cols = self.cols[s..e].iter().map(|&c| c as usize);
-            // SAFETY: forwarded from the caller.
-            unsafe { sym_row_product(values, cols, x) }
+        #[cfg(target_arch = "x86_64")]
+        if super::simd::avx2_fma() {
+            // SAFETY: forwarded from the caller; the CPU has the features (checked at run time).
+            return unsafe { self.row_times_ptr_avx2(p, x) };
         }
+        // SAFETY: forwarded from the caller.
+        unsafe { row_product!(self, p, x, sym_row_product_scalar) }
+    }
+
+    /// [`Rows32::row_times_ptr`] with the AVX2 row product inlined.
+    ///
+    /// # Safety
+    /// As [`Rows32::row_times_ptr`], and the CPU must have AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn row_times_ptr_avx2(&self, p: usize, x: *const Vec3) -> Vec3 {
+        // SAFETY: forwarded from the caller.
+        unsafe { row_product!(self, p, x, sym_row_product_avx2) }
     }
 }
 
@@ -143,24 +167,13 @@ pub unsafe fn sym_row_product(
     cols: impl Iterator<Item = usize>,
     x: *const Vec3,
 ) -> Vec3 {
-    #[cfg(all(
-        target_arch = "x86_64",
-        target_feature = "avx2",
-        target_feature = "fma"
-    ))]
-    {
-        // SAFETY: forwarded from the caller; the CPU features are enabled at compile time.
-        unsafe { sym_row_product_avx2(values, cols, x) }
+    #[cfg(target_arch = "x86_64")]
+    if super::simd::avx2_fma() {
+        // SAFETY: forwarded from the caller; the CPU has the features (checked at run time).
+        return unsafe { sym_row_product_avx2(values, cols, x) };
     }
-    #[cfg(not(all(
-        target_arch = "x86_64",
-        target_feature = "avx2",
-        target_feature = "fma"
-    )))]
-    {
-        // SAFETY: forwarded from the caller.
-        unsafe { sym_row_product_scalar(values, cols, x) }
-    }
+    // SAFETY: forwarded from the caller.
+    unsafe { sym_row_product_scalar(values, cols, x) }
 }
 
 /// [`sym_row_product`] one component at a time (any CPU).
@@ -190,12 +203,9 @@ pub unsafe fn sym_row_product_scalar(
 /// to 0.059 m/s.)
 ///
 /// # Safety
-/// As [`sym_row_product`].
-#[cfg(all(
-    target_arch = "x86_64",
-    target_feature = "avx2",
-    target_feature = "fma"
-))]
+/// As [`sym_row_product`], and the CPU must have AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
 #[inline]
 unsafe fn sym_row_product_avx2(
     values: &[Sym3f],
@@ -537,6 +547,24 @@ impl Bcsr3 {
     /// Row `i` of `A x`.
     #[inline]
     pub fn row_times(&self, i: usize, x: &[Vec3]) -> Vec3 {
+        #[cfg(target_arch = "x86_64")]
+        if super::simd::avx2_fma() {
+            // SAFETY: the CPU has the features (checked at run time).
+            return unsafe { self.row_times_avx2(i, x) };
+        }
+        self.row_times_any(i, x)
+    }
+
+    /// [`Bcsr3::row_times`] compiled for AVX2 and FMA (bit-identical: see [`super::simd`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn row_times_avx2(&self, i: usize, x: &[Vec3]) -> Vec3 {
+        self.row_times_any(i, x)
+    }
+
+    /// [`Bcsr3::row_times`] for whichever CPU features its caller was compiled with.
+    #[inline(always)]
+    fn row_times_any(&self, i: usize, x: &[Vec3]) -> Vec3 {
         let mut acc = Vec3::zeros();
         let (s, e) = (self.row_ptr[i], self.row_ptr[i + 1]);
         if self.sym.is_empty() {

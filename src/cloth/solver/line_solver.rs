@@ -14,6 +14,7 @@
 
 use super::bcsr::{Bcsr3, Mat3f, Rows32, Sym3f};
 use super::parallel::{for_each_index, for_each_mut, SyncPtr, PAR_MIN};
+use super::simd::multiversion;
 use crate::geometry::{Mat3, Vec3};
 
 /// Which family of grid lines.
@@ -166,82 +167,15 @@ impl LineSolver {
                     pen.map(|_| &self.pen_weft[..]),
                 ),
             };
-            let rows = Self::rows(a, dir);
-            let fp = SyncPtr(f.blk.as_mut_ptr());
-            let (prev1, prev2) = (&f.prev1, &f.prev2);
-            // block (p, p − back) of the line system, zero when either particle is fixed
-            let blk = |p: usize, back: usize, slot: usize| {
-                if slot == NONE || fixed[p] || fixed[p - back] {
-                    Mat3::zeros()
-                } else {
-                    rows.values[slot].to_mat3()
-                }
-            };
-            for_each_index(nl, nx * ny >= PAR_MIN, |line| {
-                let p0 = line * len;
-                // factors of the two previous particles, kept in double precision
-                let z = Mat3::zeros();
-                let (mut g_1, mut u1_1, mut u2_1) = (z, z, z);
-                let (mut g_2, mut u1_2, mut u2_2) = (z, z, z);
-                for t in 0..len {
-                    let p = p0 + t;
-                    let a2 = if t >= 2 {
-                        blk(p, 2, prev2[p])
-                    } else {
-                        Mat3::zeros()
-                    };
-                    let mut a1 = if t >= 1 {
-                        blk(p, 1, prev1[p])
-                    } else {
-                        Mat3::zeros()
-                    };
-                    let mut d = if fixed[p] {
-                        Mat3::identity()
-                    } else {
-                        match pen {
-                            Some(pn) => rows.values[rows.diag[p]].to_mat3() + pn[p].to_mat3(),
-                            None => rows.values[rows.diag[p]].to_mat3(),
-                        }
-                    };
-                    // eliminate column p − 2, then column p − 1
-                    let l2 = if t >= 2 { a2 * g_2 } else { Mat3::zeros() };
-                    if t >= 2 {
-                        a1 -= l2 * u1_2;
-                        d -= l2 * u2_2;
-                    }
-                    let l1 = if t >= 1 { a1 * g_1 } else { Mat3::zeros() };
-                    if t >= 1 {
-                        d -= l1 * u1_1;
-                    }
-                    let g = d.try_inverse().unwrap_or_else(Mat3::identity);
-                    // upper blocks (p, p + 1), (p, p + 2): transposes of later rows' lower blocks
-                    // (A is symmetric), minus the fill from column p − 1
-                    let mut u1 = if t + 1 < len {
-                        blk(p + 1, 1, prev1[p + 1]).transpose()
-                    } else {
-                        Mat3::zeros()
-                    };
-                    let u2 = if t + 2 < len {
-                        blk(p + 2, 2, prev2[p + 2]).transpose()
-                    } else {
-                        Mat3::zeros()
-                    };
-                    if t >= 1 && t + 1 < len {
-                        u1 -= l1 * u2_1;
-                    }
-                    // SAFETY: each particle belongs to exactly one line of this direction.
-                    unsafe {
-                        // W is a Schur complement of a symmetric matrix: G is symmetric
-                        *fp.at(p) = LineFactor {
-                            g: Sym3f::from_upper(&g),
-                            u1: u1.cast::<f32>(),
-                            u2: u2.cast::<f32>(),
-                        };
-                    }
-                    (g_2, u1_2, u2_2) = (g_1, u1_1, u2_1);
-                    (g_1, u1_1, u2_1) = (g, u1, u2);
-                }
-            });
+            factor_lines(
+                f,
+                Self::rows(a, dir),
+                fixed,
+                pen,
+                nl,
+                len,
+                nx * ny >= PAR_MIN,
+            );
         }
     }
 
@@ -362,68 +296,161 @@ impl LineSolver {
     }
 }
 
-/// The sweep of [`LineSolver::sweep`] in one direction's numbering: `nl` lines of `len`
-/// consecutive particles.
-#[allow(clippy::too_many_arguments)]
-fn sweep_lines(
-    f: &Factors,
-    rows: Rows32<'_>,
-    nl: usize,
-    len: usize,
-    y: &mut [Vec3],
-    r: &[Vec3],
-    e: &mut [Vec3],
-    fixed: &[bool],
-    pen: Option<&[Sym3f]>,
-    order: [usize; 3],
-    from_zero: bool,
-) {
-    let yp = SyncPtr(y.as_mut_ptr());
-    let ep = SyncPtr(e.as_mut_ptr());
-    for (pass, color) in order.into_iter().enumerate() {
-        // with e = 0 on entry, the first colour's residual is r itself
-        let skip_product = from_zero && pass == 0;
-        let count = (nl + 2 - color) / 3;
-        for_each_index(count, nl * len >= PAR_MIN, |m| {
-            let p0 = (color + 3 * m) * len;
-            // SAFETY: lines of one colour are three apart, so no element couples two of
-            // them: each task writes its own line's e and y and reads e of other colours only.
-            unsafe {
-                // residuals of the line, then forward elimination in place
-                for p in p0..p0 + len {
-                    let mut d = if fixed[p] {
-                        Vec3::zeros()
-                    } else if skip_product {
-                        r[p]
-                    } else {
-                        let mut d = r[p] - rows.row_times_ptr(p, ep.0);
-                        if let Some(pn) = pen {
-                            d -= pn[p].mul(&*ep.at(p));
-                        }
-                        d
+multiversion! {
+    /// The factorisation of [`LineSolver::factor`] for the `nl` lines of `len` particles of one
+    /// direction, whose rows (in that direction's numbering) are `rows`; in parallel when
+    /// `par`.
+    fn factor_lines(
+        f: &mut Factors,
+        rows: Rows32<'_>,
+        fixed: &[bool],
+        pen: Option<&[Sym3f]>,
+        nl: usize,
+        len: usize,
+        par: bool,
+    ) {
+        let fp = SyncPtr(f.blk.as_mut_ptr());
+        let (prev1, prev2) = (&f.prev1, &f.prev2);
+        // block (p, p − back) of the line system, zero when either particle is fixed
+        let blk = |p: usize, back: usize, slot: usize| {
+            if slot == NONE || fixed[p] || fixed[p - back] {
+                Mat3::zeros()
+            } else {
+                rows.values[slot].to_mat3()
+            }
+        };
+        for_each_index(nl, par, |line| {
+            let p0 = line * len;
+            // factors of the two previous particles, kept in double precision
+            let z = Mat3::zeros();
+            let (mut g_1, mut u1_1, mut u2_1) = (z, z, z);
+            let (mut g_2, mut u1_2, mut u2_2) = (z, z, z);
+            for t in 0..len {
+                let p = p0 + t;
+                let a2 = if t >= 2 {
+                    blk(p, 2, prev2[p])
+                } else {
+                    Mat3::zeros()
+                };
+                let mut a1 = if t >= 1 {
+                    blk(p, 1, prev1[p])
+                } else {
+                    Mat3::zeros()
+                };
+                let mut d = if fixed[p] {
+                    Mat3::identity()
+                } else {
+                    match pen {
+                        Some(pn) => rows.values[rows.diag[p]].to_mat3() + pn[p].to_mat3(),
+                        None => rows.values[rows.diag[p]].to_mat3(),
+                    }
+                };
+                // eliminate column p − 2, then column p − 1
+                let l2 = if t >= 2 { a2 * g_2 } else { Mat3::zeros() };
+                if t >= 2 {
+                    a1 -= l2 * u1_2;
+                    d -= l2 * u2_2;
+                }
+                let l1 = if t >= 1 { a1 * g_1 } else { Mat3::zeros() };
+                if t >= 1 {
+                    d -= l1 * u1_1;
+                }
+                let g = d.try_inverse().unwrap_or_else(Mat3::identity);
+                // upper blocks (p, p + 1), (p, p + 2): transposes of later rows' lower blocks
+                // (A is symmetric), minus the fill from column p − 1
+                let mut u1 = if t + 1 < len {
+                    blk(p + 1, 1, prev1[p + 1]).transpose()
+                } else {
+                    Mat3::zeros()
+                };
+                let u2 = if t + 2 < len {
+                    blk(p + 2, 2, prev2[p + 2]).transpose()
+                } else {
+                    Mat3::zeros()
+                };
+                if t >= 1 && t + 1 < len {
+                    u1 -= l1 * u2_1;
+                }
+                // SAFETY: each particle belongs to exactly one line of this direction.
+                unsafe {
+                    // W is a Schur complement of a symmetric matrix: G is symmetric
+                    *fp.at(p) = LineFactor {
+                        g: Sym3f::from_upper(&g),
+                        u1: u1.cast::<f32>(),
+                        u2: u2.cast::<f32>(),
                     };
-                    // symmetric elimination: L(p, p−1) = U(p−1, p)ᵀ G(p−1); the scratch
-                    // holds w = G y, so the multiplier is never stored
-                    if p > p0 {
-                        d -= f.blk[p - 1].u1.cast::<f64>().tr_mul(&*yp.at(p - 1));
-                    }
-                    if p >= p0 + 2 {
-                        d -= f.blk[p - 2].u2.cast::<f64>().tr_mul(&*yp.at(p - 2));
-                    }
-                    *yp.at(p) = f.blk[p].g.mul(&d);
                 }
-                let (mut x1, mut x2) = (Vec3::zeros(), Vec3::zeros());
-                for p in (p0..p0 + len).rev() {
-                    let b = &f.blk[p];
-                    let xp = *yp.at(p)
-                        - b.g
-                            .mul(&(b.u1.cast::<f64>() * x1 + b.u2.cast::<f64>() * x2));
-                    *ep.at(p) += xp;
-                    x2 = x1;
-                    x1 = xp;
-                }
+                (g_2, u1_2, u2_2) = (g_1, u1_1, u2_1);
+                (g_1, u1_1, u2_1) = (g, u1, u2);
             }
         });
+    }
+}
+
+multiversion! {
+    /// The sweep of [`LineSolver::sweep`] in one direction's numbering: `nl` lines of `len`
+    /// consecutive particles.
+    #[allow(clippy::too_many_arguments)]
+    fn sweep_lines(
+        f: &Factors,
+        rows: Rows32<'_>,
+        nl: usize,
+        len: usize,
+        y: &mut [Vec3],
+        r: &[Vec3],
+        e: &mut [Vec3],
+        fixed: &[bool],
+        pen: Option<&[Sym3f]>,
+        order: [usize; 3],
+        from_zero: bool,
+    ) {
+        let yp = SyncPtr(y.as_mut_ptr());
+        let ep = SyncPtr(e.as_mut_ptr());
+        for (pass, color) in order.into_iter().enumerate() {
+            // with e = 0 on entry, the first colour's residual is r itself
+            let skip_product = from_zero && pass == 0;
+            let count = (nl + 2 - color) / 3;
+            for_each_index(count, nl * len >= PAR_MIN, |m| {
+                let p0 = (color + 3 * m) * len;
+                // SAFETY: lines of one colour are three apart, so no element couples two of
+                // them: each task writes its own line's e and y and reads e of other colours only.
+                unsafe {
+                    // residuals of the line, then forward elimination in place
+                    for p in p0..p0 + len {
+                        let mut d = if fixed[p] {
+                            Vec3::zeros()
+                        } else if skip_product {
+                            r[p]
+                        } else {
+                            let mut d = r[p] - rows.row_times_ptr(p, ep.0);
+                            if let Some(pn) = pen {
+                                d -= pn[p].mul(&*ep.at(p));
+                            }
+                            d
+                        };
+                        // symmetric elimination: L(p, p−1) = U(p−1, p)ᵀ G(p−1); the scratch
+                        // holds w = G y, so the multiplier is never stored
+                        if p > p0 {
+                            d -= f.blk[p - 1].u1.cast::<f64>().tr_mul(&*yp.at(p - 1));
+                        }
+                        if p >= p0 + 2 {
+                            d -= f.blk[p - 2].u2.cast::<f64>().tr_mul(&*yp.at(p - 2));
+                        }
+                        *yp.at(p) = f.blk[p].g.mul(&d);
+                    }
+                    let (mut x1, mut x2) = (Vec3::zeros(), Vec3::zeros());
+                    for p in (p0..p0 + len).rev() {
+                        let b = &f.blk[p];
+                        let xp = *yp.at(p)
+                            - b.g
+                                .mul(&(b.u1.cast::<f64>() * x1 + b.u2.cast::<f64>() * x2));
+                        *ep.at(p) += xp;
+                        x2 = x1;
+                        x1 = xp;
+                    }
+                }
+            });
+        }
     }
 }
 
