@@ -10,7 +10,6 @@ pub mod error;
 pub mod model;
 pub mod parameters;
 pub mod sewing;
-pub mod simd;
 pub mod simulation;
 pub mod solver;
 pub mod stage;

@@ -12,4 +12,5 @@ pub mod line_solver;
 pub mod multigrid;
 pub mod parallel;
 pub mod pcg;
+pub mod simd;
 pub(crate) mod vcycle;

@@ -83,7 +83,7 @@ macro_rules! multiversion {
                 #[target_feature(enable = "avx2,fma")]
                 #[allow(clippy::too_many_arguments)]
                 fn avx2($($arg: $ty),*) $(-> $ret)? $body
-                if $crate::cloth::simd::avx2_fma() {
+                if $crate::cloth::solver::simd::avx2_fma() {
                     // SAFETY: the CPU has AVX2 and FMA (checked at run time).
                     return unsafe { avx2($($arg),*) };
                 }
@@ -99,7 +99,7 @@ macro_rules! multiversion {
         $(#[$attr])*
         $vis fn $name(&mut $s $(, $arg: $ty)*) $(-> $ret)? {
             #[cfg(target_arch = "x86_64")]
-            if $crate::cloth::simd::avx2_fma() {
+            if $crate::cloth::solver::simd::avx2_fma() {
                 // SAFETY: the CPU has AVX2 and FMA (checked at run time).
                 return unsafe { $s.$fast($($arg),*) };
             }
@@ -118,7 +118,7 @@ macro_rules! multiversion {
         $(#[$attr])*
         $vis fn $name(&$s $(, $arg: $ty)*) $(-> $ret)? {
             #[cfg(target_arch = "x86_64")]
-            if $crate::cloth::simd::avx2_fma() {
+            if $crate::cloth::solver::simd::avx2_fma() {
                 // SAFETY: the CPU has AVX2 and FMA (checked at run time).
                 return unsafe { $s.$fast($($arg),*) };
             }
