@@ -456,22 +456,7 @@ impl FieldReader<'_> {
 mod tests {
     use super::*;
 
-    fn cam() -> Camera {
-        Camera {
-            k1: -0.08,
-            k2: 0.02,
-            ..Camera::new(
-                400.0,
-                401.0,
-                162.0,
-                118.0,
-                Matrix3::identity(),
-                Vector3::zeros(),
-                320,
-                240,
-            )
-        }
-    }
+    use crate::geometry::camera::model::tests::cam;
 
     #[test]
     fn json_null_is_not_finite_and_names_field() {

@@ -191,10 +191,11 @@ impl Camera {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn cam() -> Camera {
+    /// A distorted 320×240 test camera, shared by the camera's tests.
+    pub(crate) fn cam() -> Camera {
         Camera {
             k1: -0.08,
             k2: 0.02,
