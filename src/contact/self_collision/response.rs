@@ -130,7 +130,7 @@ impl SelfCollision {
     }
 
     /// 1. Repulsion: pairs closer than `thickness` at `x0` lose their approach (a push apart of
-    /// a fraction of the overlap, Coulomb friction `friction` on the tangential displacement).
+    ///    a fraction of the overlap, Coulomb friction `friction` on the tangential displacement).
     fn repel(
         &mut self,
         x0: &[Vec3],
@@ -185,7 +185,7 @@ impl SelfCollision {
     }
 
     /// 2. Continuous-detection passes: each hit gets an impulse leaving its pair a fraction of
-    /// the thickness apart. Whether no hit is left (`hits` holds the last pass's).
+    ///    the thickness apart. Whether no hit is left (`hits` holds the last pass's).
     fn ccd_passes(
         &mut self,
         x0: &[Vec3],
@@ -226,7 +226,7 @@ impl SelfCollision {
     }
 
     /// 3. Impact zones: the vertices of colliding pairs merge into zones moved rigidly, round
-    /// by round. Whether no hit is left.
+    ///    by round. Whether no hit is left.
     fn impact_zones(
         &mut self,
         x0: &[Vec3],
