@@ -1,7 +1,7 @@
 //! Garments from 2D sewing patterns: pattern pieces and seams ([`pattern`]) with their
 //! outlines, checks and expansion, their files ([`formats`]: JSON, SVG, DXF-AAMA, pattern
 //! sheets), meshing of the pieces ([`mesh`]), automatic placement around a mannequin
-//! ([`placement`]) and sewing into one cloth ([`dress`], [`seam_hinges`]).
+//! ([`placement`]) and sewing into one cloth ([`mod@dress`], [`seam_hinges`]).
 
 pub mod dress;
 pub mod error;

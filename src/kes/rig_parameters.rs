@@ -1,6 +1,6 @@
 //! The KES parameters of a virtual experiment: a rig path split into its loading and
 //! hysteresis branches ([`branches`]), the standard formulas applied to them per test
-//! ([`simulated_params`]), and the measured value each is compared with ([`measured_value`]).
+//! (`simulated_params`), and the measured value each is compared with (`measured_value`).
 //! Shared by the fitting of a law ([`super::fit`]) and the lab ([`super::lab`]).
 
 use super::calibrate::{LawModel, RigRun};

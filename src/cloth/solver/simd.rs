@@ -1,6 +1,6 @@
 //! Run-time CPU-feature dispatch for the solver's hot kernels. The default build is portable
 //! (no `target-cpu=native`), so a binary runs on any CPU of its target; the kernels that gain
-//! from wider vectors are compiled twice with [`multiversion!`], generic and with AVX2 and FMA
+//! from wider vectors are compiled twice with `multiversion!`, generic and with AVX2 and FMA
 //! enabled, and each call takes the AVX2 form when [`avx2_fma`] says the CPU has both.
 //!
 //! Both forms compute bit-identical results: enabling a feature changes the instructions, not

@@ -4,7 +4,7 @@
 //!
 //! This module owns the triangulation of a piece's interior and the assembly of the
 //! [`GarmentMesh`]; the boundary sampling (seam edges at common arc-length fractions) lives in
-//! [`boundary`]. How a piece is meshed: its sampled outline, rotated so the grain line is
+//! `boundary`. How a piece is meshed: its sampled outline, rotated so the grain line is
 //! +u, is the constraint loop of a constrained Delaunay triangulation (spade); the interior is
 //! seeded with a hexagonal lattice aligned with the warp (rows along the grain), kept at least
 //! 0.6 edge length from the boundary; the lattice vertices near the boundary are smoothed

@@ -1,5 +1,5 @@
 //! Cameras: the one pinhole camera model with radial distortion ([`Camera`]), its JSON file
-//! format ([`file`]), and the eye/target/up placement the renderer and scripts use
+//! format ([`mod@file`]), and the eye/target/up placement the renderer and scripts use
 //! ([`LookAtCamera`], which converts to a [`Camera`]).
 //!
 //! # Model

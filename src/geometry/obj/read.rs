@@ -13,7 +13,7 @@ use crate::geometry::{GeometryError, TriMesh, Vec3};
 /// (pattern) coordinates in metres, so every face corner needs one (`f 1/1 2/2 3/3`); each
 /// distinct (position, texture coordinate) pair becomes one vertex, numbered in the order of
 /// the `v` lines (a position used with several texture coordinates, as along a seam, gives one
-/// vertex per coordinate, in `vt` order), so a file written by [`write_obj`] reads back with
+/// vertex per coordinate, in `vt` order), so a file written by [`super::write_obj`] reads back with
 /// the same numbering. Normal indices are ignored (flat-shaded exports stay connected), as are
 /// positions no face uses, objects and groups (all merged), materials, points and lines.
 /// Polygons are split into triangle fans; a `v` line's optional fourth number divides it
