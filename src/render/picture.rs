@@ -1,15 +1,15 @@
 //! Shaded pictures: z-buffered, perspective-correct triangles with smooth double-sided
 //! Lambert shading over a light gradient background, 2 × 2 supersampled, deterministic; and
-//! PNG output of the result. Its triangle fill (floating-point edge functions, samples at
-//! half-integer pixel coordinates, normals interpolated for shading) is kept apart from the
-//! vision rasterizer ([`super::raster`], integer edge functions and the top-left rule) so
-//! that pictures stay bit-identical.
+//! PNG output of the result. Triangles are filled by the crate's one traversal
+//! ([`super::raster::TriangleScan`]: integer edge functions, the top-left rule), with
+//! perspective-correct depth, normals and positions interpolated for shading.
 
 use std::io::Write;
 use std::path::Path;
 
 use image::{ImageEncoder, RgbImage};
 
+use super::raster::TriangleScan;
 use super::shading::{background, shade, srgb_to_linear};
 use crate::geometry::camera::look_at::{Frame, MAX_SIZE, NEAR};
 use crate::geometry::camera::LookAtCamera;
@@ -205,64 +205,36 @@ fn clip_near(v: &[CamVertex; 3]) -> ([CamVertex; 4], usize) {
     (out, len)
 }
 
-/// Signed doubled area of (a, b, p): positive when p is left of a→b in pixel coordinates.
-fn edge(a: (f64, f64), b: (f64, f64), p: (f64, f64)) -> f64 {
-    (b.0 - a.0) * (p.1 - a.1) - (b.1 - a.1) * (p.0 - a.0)
-}
-
-/// Rasterizes one triangle in front of the near plane into the sample buffers.
+/// Rasterizes one triangle in front of the near plane into the sample buffers, through the
+/// crate's one triangle traversal ([`TriangleScan`]); samples sit at pixel centres
+/// `(i + 0.5, j + 0.5)` of the frame's pixel coordinates.
 fn raster(t: &mut Target, frame: &Frame, v: [CamVertex; 3], face_n: &Vec3, base: &[f64; 3]) {
-    let s = v.map(|v| frame.pixel(&v.p));
-    let area = edge(s[0], s[1], s[2]);
-    if area.is_nan() || area.abs() <= 1e-12 {
+    let corners = v.map(|v| {
+        let (x, y) = frame.pixel(&v.p);
+        [x - 0.5, y - 0.5]
+    });
+    let Some(scan) = TriangleScan::new(corners, t.w, t.h) else {
         return;
-    }
-    let (min_x, max_x) = (
-        s[0].0.min(s[1].0).min(s[2].0),
-        s[0].0.max(s[1].0).max(s[2].0),
-    );
-    let (min_y, max_y) = (
-        s[0].1.min(s[1].1).min(s[2].1),
-        s[0].1.max(s[1].1).max(s[2].1),
-    );
-    // Samples at (i + 0.5, j + 0.5) inside the bounding box, within the image.
-    let range = |lo: f64, hi: f64, n: usize| {
-        let a = (lo - 0.5).ceil().max(0.0);
-        let b = (hi - 0.5).floor().min(n as f64 - 1.0);
-        (a as usize, b as isize)
     };
-    let (x0, x1) = range(min_x, max_x, t.w);
-    let (y0, y1) = range(min_y, max_y, t.h);
-    if x1 < x0 as isize || y1 < y0 as isize {
-        return;
-    }
-    let inv_z = v.map(|v| 1.0 / v.p.z);
-    const EPS: f64 = -1e-9;
-    for y in y0..=y1 as usize {
-        let py = y as f64 + 0.5;
-        for x in x0..=x1 as usize {
-            let p = (x as f64 + 0.5, py);
-            let b = [
-                edge(s[1], s[2], p) / area,
-                edge(s[2], s[0], p) / area,
-                edge(s[0], s[1], p) / area,
-            ];
-            if b[0] < EPS || b[1] < EPS || b[2] < EPS {
-                continue;
-            }
-            let q = [b[0] * inv_z[0], b[1] * inv_z[1], b[2] * inv_z[2]];
-            let qs = q[0] + q[1] + q[2];
-            let z = 1.0 / qs;
-            let idx = y * t.w + x;
-            if z.is_nan() || z >= t.depth[idx] {
-                continue;
-            }
-            t.depth[idx] = z;
-            let normal = (v[0].n * q[0] + v[1].n * q[1] + v[2].n * q[2]) * z;
-            let point = (v[0].p * q[0] + v[1].p * q[1] + v[2].p * q[2]) * z;
-            t.color[idx] = shade(base, &normal, face_n, &point);
+    let o = scan.order();
+    let inv_z = [1.0 / v[o[0]].p.z, 1.0 / v[o[1]].p.z, 1.0 / v[o[2]].p.z];
+    let v = [v[o[0]], v[o[1]], v[o[2]]];
+    scan.for_each(|x, y, l| {
+        let q = [
+            f64::from(l[0]) * inv_z[0],
+            f64::from(l[1]) * inv_z[1],
+            f64::from(l[2]) * inv_z[2],
+        ];
+        let z = 1.0 / (q[0] + q[1] + q[2]);
+        let idx = y * t.w + x;
+        if z.is_nan() || z >= t.depth[idx] {
+            return;
         }
-    }
+        t.depth[idx] = z;
+        let normal = (v[0].n * q[0] + v[1].n * q[1] + v[2].n * q[2]) * z;
+        let point = (v[0].p * q[0] + v[1].p * q[1] + v[2].p * q[2]) * z;
+        t.color[idx] = shade(base, &normal, face_n, &point);
+    });
 }
 
 #[cfg(test)]

@@ -157,97 +157,164 @@ fn draw_one(target: &mut RasterTarget, p: [&[f32; 3]; 3], c: [&[f32; 3]; 3]) {
     if !(valid(p[0]) && valid(p[1]) && valid(p[2])) {
         return;
     }
-    let snap = |v: f32| (v as f64 * SUBPIXEL).round() as i64;
-    let mut v = [
-        (snap(p[0][0]), snap(p[0][1])),
-        (snap(p[1][0]), snap(p[1][1])),
-        (snap(p[2][0]), snap(p[2][1])),
-    ];
-    let mut order = [0usize, 1, 2];
-    let edge = |a: (i64, i64), b: (i64, i64), q: (i64, i64)| {
-        (b.0 - a.0) * (q.1 - a.1) - (b.1 - a.1) * (q.0 - a.0)
+    let corners = p.map(|p| [p[0] as f64, p[1] as f64]);
+    let Some(scan) = TriangleScan::new(corners, target.width, target.height) else {
+        return;
     };
-    let mut area = edge(v[0], v[1], v[2]);
-    if area == 0 {
-        return;
-    }
-    if area < 0 {
-        v.swap(1, 2);
-        order.swap(1, 2);
-        area = -area;
-    }
-    // pixel range whose centres (integer projected coordinates) may be inside
-    let s = SUBPIXEL as i64;
-    let (min_x, max_x) = (
-        v[0].0.min(v[1].0).min(v[2].0),
-        v[0].0.max(v[1].0).max(v[2].0),
-    );
-    let (min_y, max_y) = (
-        v[0].1.min(v[1].1).min(v[2].1),
-        v[0].1.max(v[1].1).max(v[2].1),
-    );
-    let x0 = (min_x + s - 1).div_euclid(s).max(0);
-    let y0 = (min_y + s - 1).div_euclid(s).max(0);
-    let x1 = (max_x.div_euclid(s) + 1).min(target.width as i64);
-    let y1 = (max_y.div_euclid(s) + 1).min(target.height as i64);
-    if x0 >= x1 || y0 >= y1 {
-        return;
-    }
-    target.touch(x0 as usize, y0 as usize, x1 as usize, y1 as usize);
-
-    // edge k is opposite vertex k: w_k(q) = edge(v[k+1], v[k+2], q); a pixel on an edge is
-    // inside only for top-left edges (bias −1 on the others, the test being w >= 0)
-    let e = [(1usize, 2usize), (2, 0), (0, 1)];
-    let mut w_row = [0i64; 3];
-    let mut step_x = [0i64; 3];
-    let mut step_y = [0i64; 3];
-    let mut bias = [0f32; 3];
-    let start = (x0 * s, y0 * s);
-    for k in 0..3 {
-        let (a, b) = (v[e[k].0], v[e[k].1]);
-        let (dx, dy) = (b.0 - a.0, b.1 - a.1);
-        let top_left = dy < 0 || (dy == 0 && dx > 0);
-        w_row[k] = edge(a, b, start) - i64::from(!top_left);
-        bias[k] = f32::from(u8::from(!top_left));
-        step_x[k] = -dy * s;
-        step_y[k] = dx * s;
-    }
-    let inv_area = 1.0 / area as f32;
+    let (x0, y0, x1, y1) = scan.pixel_box();
+    target.touch(x0, y0, x1, y1);
+    let order = scan.order();
     let pz = [p[order[0]][2], p[order[1]][2], p[order[2]][2]];
     let iz = [1.0 / pz[0], 1.0 / pz[1], 1.0 / pz[2]];
     let col = [c[order[0]], c[order[1]], c[order[2]]];
     let width = target.width;
-    for y in y0..y1 {
-        let mut w = w_row;
-        let row = y as usize * width;
-        for x in x0..x1 {
-            if (w[0] | w[1] | w[2]) >= 0 {
-                // barycentric weights (the fill-rule biases added back)
-                let l = [
-                    (w[0] as f32 + bias[0]) * inv_area,
-                    (w[1] as f32 + bias[1]) * inv_area,
-                    (w[2] as f32 + bias[2]) * inv_area,
-                ];
-                let inv_z = l[0] * iz[0] + l[1] * iz[1] + l[2] * iz[2];
-                let z = 1.0 / inv_z;
-                let i = row + x as usize;
-                if z < target.depth[i] {
-                    target.depth[i] = z;
-                    target.rgb[i] = [
-                        l[0] * col[0][0] + l[1] * col[1][0] + l[2] * col[2][0],
-                        l[0] * col[0][1] + l[1] * col[1][1] + l[2] * col[2][1],
-                        l[0] * col[0][2] + l[1] * col[1][2] + l[2] * col[2][2],
+    scan.for_each(|x, y, l| {
+        let inv_z = l[0] * iz[0] + l[1] * iz[1] + l[2] * iz[2];
+        let z = 1.0 / inv_z;
+        let i = y * width + x;
+        if z < target.depth[i] {
+            target.depth[i] = z;
+            target.rgb[i] = [
+                l[0] * col[0][0] + l[1] * col[1][0] + l[2] * col[2][0],
+                l[0] * col[0][1] + l[1] * col[1][1] + l[2] * col[2][1],
+                l[0] * col[0][2] + l[1] * col[1][2] + l[2] * col[2][2],
+            ];
+        }
+    });
+}
+
+/// The pixel traversal of one triangle, shared by every triangle fill of the crate (this
+/// module's [`draw_triangles`] and the shaded pictures of [`super::picture`]): the corners
+/// snapped to 1/256 pixel, integer edge functions, the top-left fill rule, pixel `(x, y)`
+/// sampled at the point `(x, y)` of the corner coordinates (see the module conventions).
+/// Barycentric weights are given in the scan's vertex order ([`TriangleScan::order`]), which
+/// makes the triangle counter-clockwise in pixel coordinates.
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleScan {
+    /// Covered-pixel candidates `x0..x1 × y0..y1` (clipped to the image).
+    bounds: (usize, usize, usize, usize),
+    /// Edge functions (biased by the fill rule) at the first candidate of the first row.
+    w_row: [i64; 3],
+    step_x: [i64; 3],
+    step_y: [i64; 3],
+    /// Fill-rule bias of each edge, added back to form the weights.
+    bias: [f32; 3],
+    inv_area: f32,
+    order: [usize; 3],
+}
+
+impl TriangleScan {
+    /// Sets up the traversal of the triangle with corners `p` (pixel coordinates) in an image
+    /// of `width × height` pixels. `None` when the triangle has no area once snapped, covers
+    /// no pixel centre's box inside the image, or has a corner that is not finite or lies
+    /// farther than 10⁶ pixels from the origin.
+    pub fn new(p: [[f64; 2]; 3], width: usize, height: usize) -> Option<Self> {
+        let lim = MAX_COORD as f64;
+        if !p.iter().flatten().all(|c| c.abs() < lim) {
+            return None;
+        }
+        let snap = |v: f64| (v * SUBPIXEL).round() as i64;
+        let mut v = p.map(|q| (snap(q[0]), snap(q[1])));
+        let mut order = [0usize, 1, 2];
+        let mut area = edge(v[0], v[1], v[2]);
+        if area == 0 {
+            return None;
+        }
+        if area < 0 {
+            v.swap(1, 2);
+            order.swap(1, 2);
+            area = -area;
+        }
+        // pixel range whose centres (integer coordinates) may be inside
+        let s = SUBPIXEL as i64;
+        let (min_x, max_x) = (
+            v[0].0.min(v[1].0).min(v[2].0),
+            v[0].0.max(v[1].0).max(v[2].0),
+        );
+        let (min_y, max_y) = (
+            v[0].1.min(v[1].1).min(v[2].1),
+            v[0].1.max(v[1].1).max(v[2].1),
+        );
+        let x0 = (min_x + s - 1).div_euclid(s).max(0);
+        let y0 = (min_y + s - 1).div_euclid(s).max(0);
+        let x1 = (max_x.div_euclid(s) + 1).min(width as i64);
+        let y1 = (max_y.div_euclid(s) + 1).min(height as i64);
+        if x0 >= x1 || y0 >= y1 {
+            return None;
+        }
+        // edge k is opposite vertex k: w_k(q) = edge(v[k+1], v[k+2], q); a pixel on an edge
+        // is inside only for top-left edges (bias −1 on the others, the test being w >= 0)
+        let e = [(1usize, 2usize), (2, 0), (0, 1)];
+        let mut w_row = [0i64; 3];
+        let mut step_x = [0i64; 3];
+        let mut step_y = [0i64; 3];
+        let mut bias = [0f32; 3];
+        let start = (x0 * s, y0 * s);
+        for k in 0..3 {
+            let (a, b) = (v[e[k].0], v[e[k].1]);
+            let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+            let top_left = dy < 0 || (dy == 0 && dx > 0);
+            w_row[k] = edge(a, b, start) - i64::from(!top_left);
+            bias[k] = f32::from(u8::from(!top_left));
+            step_x[k] = -dy * s;
+            step_y[k] = dx * s;
+        }
+        Some(TriangleScan {
+            bounds: (x0 as usize, y0 as usize, x1 as usize, y1 as usize),
+            w_row,
+            step_x,
+            step_y,
+            bias,
+            inv_area: 1.0 / area as f32,
+            order,
+        })
+    }
+
+    /// The candidate pixels `(x0, y0, x1, y1)` (exclusive ends), inside the image.
+    pub fn pixel_box(&self) -> (usize, usize, usize, usize) {
+        self.bounds
+    }
+
+    /// Weight `k` of [`for_each`](Self::for_each) belongs to corner `order()[k]` of the
+    /// corners given to [`new`](Self::new).
+    pub fn order(&self) -> [usize; 3] {
+        self.order
+    }
+
+    /// Calls `visit(x, y, weights)` for every covered pixel, row by row, with the barycentric
+    /// weights of its centre in scan order.
+    #[inline(always)]
+    pub fn for_each(&self, mut visit: impl FnMut(usize, usize, [f32; 3])) {
+        let (x0, y0, x1, y1) = self.bounds;
+        let mut w_row = self.w_row;
+        let (bias, inv_area) = (self.bias, self.inv_area);
+        for y in y0..y1 {
+            let mut w = w_row;
+            for x in x0..x1 {
+                if (w[0] | w[1] | w[2]) >= 0 {
+                    // barycentric weights (the fill-rule biases added back)
+                    let l = [
+                        (w[0] as f32 + bias[0]) * inv_area,
+                        (w[1] as f32 + bias[1]) * inv_area,
+                        (w[2] as f32 + bias[2]) * inv_area,
                     ];
+                    visit(x, y, l);
+                }
+                for k in 0..3 {
+                    w[k] += self.step_x[k];
                 }
             }
             for k in 0..3 {
-                w[k] += step_x[k];
+                w_row[k] += self.step_y[k];
             }
         }
-        for k in 0..3 {
-            w_row[k] += step_y[k];
-        }
     }
+}
+
+/// Doubled signed area of `(a, b, q)` in snapped integer coordinates.
+#[inline]
+fn edge(a: (i64, i64), b: (i64, i64), q: (i64, i64)) -> i64 {
+    (b.0 - a.0) * (q.1 - a.1) - (b.1 - a.1) * (q.0 - a.0)
 }
 
 #[cfg(test)]
