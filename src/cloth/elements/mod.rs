@@ -75,7 +75,7 @@ pub struct SpringEval {
 
 impl Spring {
     /// Evaluates the spring at positions `xa`, `xb`.
-    #[inline]
+    #[inline(always)]
     pub fn eval(&self, law: &dyn MaterialLaw, xa: &Vec3, xb: &Vec3) -> SpringEval {
         let d = xb - xa;
         let len = d.norm();
@@ -273,7 +273,7 @@ impl BendLine {
     /// does not read as bending: q' = q · d1 d2 / (l1 l2), with q the second difference,
     /// d the rest and l the current spacings (points on a circle give |q'| = 1/R exactly,
     /// whatever their spacing).
-    #[inline]
+    #[inline(always)]
     pub fn geometry(&self, x: &[Vec3]) -> BendGeometry {
         let [a, b, c] = self.nodes;
         let q = self.curvature(x);
@@ -374,7 +374,7 @@ impl ShearQuad {
     }
 
     /// The diagonals, γ and its derivatives at positions `x`.
-    #[inline]
+    #[inline(always)]
     pub fn measure(&self, x: &[Vec3]) -> ShearMeasure {
         let [a1, b1, a2, b2] = self.nodes;
         let d1 = x[b1] - x[a1];

@@ -13,6 +13,7 @@ use rayon::prelude::*;
 use super::bcsr::{Bcsr3, Sym3, Sym3f, SYM_ROW_MAX};
 use super::contribution::{contribute_all, Pass};
 use super::parallel::{chunks, stream_copy, stream_fence, SyncPtr, CHUNK};
+use super::simd::multiversion;
 use crate::cloth::elements::material::Direction;
 use crate::cloth::model::ClothModel;
 use crate::geometry::{Mat3, Vec3};
@@ -310,9 +311,6 @@ impl Assembly {
 
     fn gather_pass(&mut self, model: &ClothModel, v: &[Vec3], inp: AssemblyInputs) {
         let n = model.particle_count();
-        let drag = model.fabric.air_drag;
-        let h = inp.dt;
-        let matrix = inp.matrix;
         // general blocks in `values`, or symmetric ones in `sym` (or none, single-precision
         // mirrors only), always with a mirror: see `Bcsr3::store_symmetric`
         let general = !self.a.values.is_empty();
@@ -320,123 +318,216 @@ impl Assembly {
             general || !self.a.values32.is_empty(),
             "a matrix without general blocks keeps its single-precision mirror"
         );
-        let values = SyncPtr(self.a.values.as_mut_ptr());
-        let sym = (!self.a.sym.is_empty()).then_some(SyncPtr(self.a.sym.as_mut_ptr()));
-        let mirror = !self.a.values32.is_empty();
-        let jacobi = self.jacobi;
-        let values32 = SyncPtr(self.a.values32.as_mut_ptr());
         let (perm32, perm_start) = match &mut self.a.permuted {
             Some(pm) => (Some(SyncPtr(pm.values.as_mut_ptr())), &pm.row_start[..]),
             None => (None, &[][..]),
         };
-        let (row_ptr, diag) = (&self.a.row_ptr, &self.a.diag);
-        let (recs, rec_ptr, grecs, grec_ptr) =
-            (&self.recs, &self.rec_ptr, &self.grecs, &self.grec_ptr);
-        let (rec_scale, scales, spill) = (&self.rec_scale, &self.scales, &self.scale_spill);
-        let scale = |k: usize| match rec_scale[k] {
-            SPILL => spill[k],
-            t => scales[t as usize],
+        let rows = RowGather {
+            model,
+            v,
+            inp,
+            drag: model.fabric.air_drag,
+            general,
+            values: SyncPtr(self.a.values.as_mut_ptr()),
+            sym: (!self.a.sym.is_empty()).then_some(SyncPtr(self.a.sym.as_mut_ptr())),
+            mirror: !self.a.values32.is_empty(),
+            jacobi: self.jacobi,
+            values32: SyncPtr(self.a.values32.as_mut_ptr()),
+            perm32,
+            perm_start,
+            row_ptr: &self.a.row_ptr,
+            diag: &self.a.diag,
+            recs: &self.recs,
+            rec_ptr: &self.rec_ptr,
+            grecs: &self.grecs,
+            grec_ptr: &self.grec_ptr,
+            rec_scale: &self.rec_scale,
+            scales: &self.scales,
+            spill: &self.scale_spill,
+            blocks: &self.blocks,
+            hinge_blocks: &self.hinge_blocks,
+            g: &self.g,
+            nsym: self.hinge_block0,
         };
-        let (blocks, hinge_blocks, g) = (&self.blocks, &self.hinge_blocks, &self.g);
-        let nsym = self.hinge_block0;
-        self.b
-            .par_chunks_mut(CHUNK)
-            .zip(self.pinv.par_chunks_mut(CHUNK))
+        gather_rows(&rows, &mut self.b, &mut self.pinv);
+        debug_assert_eq!(self.b.len(), n);
+    }
+}
+
+multiversion! {
+    /// Pass 2 over all rows, in parallel chunks (see [`RowGather::chunk`]).
+    fn gather_rows(rows: &RowGather<'_>, b: &mut [Vec3], pinv: &mut [Mat3]) {
+        b.par_chunks_mut(CHUNK)
+            .zip(pinv.par_chunks_mut(CHUNK))
             .enumerate()
-            .for_each(|(c, (bs, ps))| {
-                for k in 0..bs.len() {
-                    let i = c * CHUNK + k;
-                    let m = model.mass[i];
-                    let da = drag * model.area[i];
-                    let mut rhs = inp.gravity * m - v[i] * da;
-                    if matrix {
-                        rhs *= h;
+            .for_each(|(c, (bs, ps))| rows.chunk(c, bs, ps));
+    }
+}
+
+/// What pass 2 reads and where it writes: the model, the step's inputs, the element buffers
+/// of pass 1 with their records, and the matrix storage (raw pointers: each row writes its own
+/// slots only).
+#[derive(Clone, Copy)]
+struct RowGather<'a> {
+    model: &'a ClothModel,
+    v: &'a [Vec3],
+    inp: AssemblyInputs,
+    drag: f64,
+    general: bool,
+    values: SyncPtr<Mat3>,
+    sym: Option<SyncPtr<Sym3>>,
+    mirror: bool,
+    jacobi: bool,
+    values32: SyncPtr<Sym3f>,
+    perm32: Option<SyncPtr<Sym3f>>,
+    perm_start: &'a [usize],
+    row_ptr: &'a [usize],
+    diag: &'a [usize],
+    recs: &'a [Rec],
+    rec_ptr: &'a [usize],
+    grecs: &'a [u32],
+    grec_ptr: &'a [usize],
+    rec_scale: &'a [u8],
+    scales: &'a [f64],
+    spill: &'a [f64],
+    blocks: &'a [Sym3],
+    hinge_blocks: &'a [Mat3],
+    g: &'a [Vec3],
+    nsym: usize,
+}
+
+impl RowGather<'_> {
+    /// Record `k`'s scale.
+    #[inline(always)]
+    fn scale(&self, k: usize) -> f64 {
+        match self.rec_scale[k] {
+            SPILL => self.spill[k],
+            t => self.scales[t as usize],
+        }
+    }
+
+    /// Rows `c · CHUNK ..` (as many as `bs` holds): right-hand side into `bs`, matrix rows
+    /// into the storage, inverse diagonal blocks into `ps` when block Jacobi is on.
+    #[inline(always)]
+    fn chunk(&self, c: usize, bs: &mut [Vec3], ps: &mut [Mat3]) {
+        let RowGather {
+            model,
+            v,
+            inp,
+            drag,
+            general,
+            values,
+            sym,
+            mirror,
+            jacobi,
+            values32,
+            perm32,
+            perm_start,
+            row_ptr,
+            diag,
+            recs,
+            rec_ptr,
+            grecs,
+            grec_ptr,
+            blocks,
+            hinge_blocks,
+            g,
+            nsym,
+            ..
+        } = *self;
+        let (h, matrix) = (inp.dt, inp.matrix);
+        let scale = |k: usize| self.scale(k);
+        for k in 0..bs.len() {
+            let i = c * CHUNK + k;
+            let m = model.mass[i];
+            let da = drag * model.area[i];
+            let mut rhs = inp.gravity * m - v[i] * da;
+            if matrix {
+                rhs *= h;
+            }
+            for &src in &grecs[grec_ptr[i]..grec_ptr[i + 1]] {
+                if src & NEG == 0 {
+                    rhs += g[src as usize];
+                } else {
+                    rhs -= g[(src & !NEG) as usize];
+                }
+            }
+            bs[k] = rhs;
+            if !matrix {
+                continue;
+            }
+            let (s0, s1) = (row_ptr[i], row_ptr[i + 1]);
+            let dm = m + h * da;
+            // SAFETY: row i's slots belong to this iteration only.
+            unsafe {
+                if general {
+                    for s in s0..s1 {
+                        *values.at(s) = Mat3::zeros();
                     }
-                    for &src in &grecs[grec_ptr[i]..grec_ptr[i + 1]] {
-                        if src & NEG == 0 {
-                            rhs += g[src as usize];
+                    *values.at(diag[i]) = Mat3::identity() * dm;
+                    for k in rec_ptr[i]..rec_ptr[i + 1] {
+                        let (r, src) = (recs[k], recs[k].src as usize);
+                        let blk = if src < nsym {
+                            blocks[src].to_mat3()
                         } else {
-                            rhs -= g[(src & !NEG) as usize];
+                            hinge_blocks[src - nsym]
+                        };
+                        *values.at(r.slot as usize) += blk * scale(k);
+                    }
+                    if mirror {
+                        for s in s0..s1 {
+                            *values32.at(s) = Sym3f::from_upper(&*values.at(s));
                         }
                     }
-                    bs[k] = rhs;
-                    if !matrix {
-                        continue;
+                    if jacobi {
+                        ps[k] = block_inverse(&*values.at(diag[i]));
                     }
-                    let (s0, s1) = (row_ptr[i], row_ptr[i + 1]);
-                    let dm = m + h * da;
-                    // SAFETY: row i's slots belong to this iteration only.
-                    unsafe {
-                        if general {
-                            for s in s0..s1 {
-                                *values.at(s) = Mat3::zeros();
-                            }
-                            *values.at(diag[i]) = Mat3::identity() * dm;
-                            for k in rec_ptr[i]..rec_ptr[i + 1] {
-                                let (r, src) = (recs[k], recs[k].src as usize);
-                                let blk = if src < nsym {
-                                    blocks[src].to_mat3()
-                                } else {
-                                    hinge_blocks[src - nsym]
-                                };
-                                *values.at(r.slot as usize) += blk * scale(k);
-                            }
-                            if mirror {
-                                for s in s0..s1 {
-                                    *values32.at(s) = Sym3f::from_upper(&*values.at(s));
-                                }
-                            }
-                            if jacobi {
-                                ps[k] = block_inverse(&*values.at(diag[i]));
-                            }
-                            if let Some(p) = perm32 {
-                                let at = perm_start[i];
-                                for s in s0..s1 {
-                                    *p.at(at + s - s0) = *values32.at(s);
-                                }
-                            }
-                        } else {
-                            // symmetric blocks: the row summed here, then written once to each
-                            // stored copy
-                            let mut buf = [std::mem::MaybeUninit::<Sym3>::uninit(); SYM_ROW_MAX];
-                            for b in &mut buf[..s1 - s0] {
-                                b.write(Sym3::default());
-                            }
-                            // SAFETY: the first s1 − s0 entries were just written (a row has
-                            // at most SYM_ROW_MAX blocks: `Bcsr3::store_symmetric` checked).
-                            let row = &mut *(&mut buf[..s1 - s0] as *mut [_] as *mut [Sym3]);
-                            row[diag[i] - s0] = Sym3([dm, 0.0, 0.0, dm, 0.0, dm]);
-                            for k in rec_ptr[i]..rec_ptr[i + 1] {
-                                let (r, src) = (recs[k], recs[k].src as usize);
-                                let to = &mut row[r.slot as usize - s0];
-                                if src < nsym {
-                                    to.add_scaled_sym(&blocks[src], scale(k));
-                                } else {
-                                    to.add_scaled(&hinge_blocks[src - nsym], scale(k));
-                                }
-                            }
-                            let row = &*row;
-                            if let Some(sp) = sym {
-                                stream_copy(sp.at(s0), row);
-                            }
-                            let mut buf32 = [Sym3f::default(); SYM_ROW_MAX];
-                            for (o, b) in buf32.iter_mut().zip(row) {
-                                *o = b.to_f32();
-                            }
-                            let row32 = &buf32[..s1 - s0];
-                            stream_copy(values32.at(s0), row32);
-                            if let Some(p) = perm32 {
-                                stream_copy(p.at(perm_start[i]), row32);
-                            }
-                            if jacobi {
-                                ps[k] = block_inverse(&row[diag[i] - s0].to_mat3());
-                            }
+                    if let Some(p) = perm32 {
+                        let at = perm_start[i];
+                        for s in s0..s1 {
+                            *p.at(at + s - s0) = *values32.at(s);
                         }
+                    }
+                } else {
+                    // symmetric blocks: the row summed here, then written once to each
+                    // stored copy
+                    let mut buf = [std::mem::MaybeUninit::<Sym3>::uninit(); SYM_ROW_MAX];
+                    for b in &mut buf[..s1 - s0] {
+                        b.write(Sym3::default());
+                    }
+                    // SAFETY: the first s1 − s0 entries were just written (a row has
+                    // at most SYM_ROW_MAX blocks: `Bcsr3::store_symmetric` checked).
+                    let row = &mut *(&mut buf[..s1 - s0] as *mut [_] as *mut [Sym3]);
+                    row[diag[i] - s0] = Sym3([dm, 0.0, 0.0, dm, 0.0, dm]);
+                    for k in rec_ptr[i]..rec_ptr[i + 1] {
+                        let (r, src) = (recs[k], recs[k].src as usize);
+                        let to = &mut row[r.slot as usize - s0];
+                        if src < nsym {
+                            to.add_scaled_sym(&blocks[src], scale(k));
+                        } else {
+                            to.add_scaled(&hinge_blocks[src - nsym], scale(k));
+                        }
+                    }
+                    let row = &*row;
+                    if let Some(sp) = sym {
+                        stream_copy(sp.at(s0), row);
+                    }
+                    let mut buf32 = [Sym3f::default(); SYM_ROW_MAX];
+                    for (o, b) in buf32.iter_mut().zip(row) {
+                        *o = b.to_f32();
+                    }
+                    let row32 = &buf32[..s1 - s0];
+                    stream_copy(values32.at(s0), row32);
+                    if let Some(p) = perm32 {
+                        stream_copy(p.at(perm_start[i]), row32);
+                    }
+                    if jacobi {
+                        ps[k] = block_inverse(&row[diag[i] - s0].to_mat3());
                     }
                 }
-                stream_fence();
-            });
-        debug_assert_eq!(self.b.len(), n);
+            }
+        }
+        stream_fence();
     }
 }
 

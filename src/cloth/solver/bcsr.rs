@@ -4,6 +4,8 @@
 
 use rayon::prelude::*;
 
+#[cfg(target_arch = "x86_64")]
+use super::simd::Level;
 use crate::geometry::{Mat3, Vec3};
 
 /// Rows per parallel task.
@@ -136,9 +138,12 @@ impl Rows32<'_> {
     #[inline]
     pub unsafe fn row_times_ptr(&self, p: usize, x: *const Vec3) -> Vec3 {
         #[cfg(target_arch = "x86_64")]
-        if super::simd::avx2_fma() {
+        match super::simd::level() {
             // SAFETY: forwarded from the caller; the CPU has the features (checked at run time).
-            return unsafe { self.row_times_ptr_avx2(p, x) };
+            Level::Avx512 => return unsafe { self.row_times_ptr_avx512(p, x) },
+            // SAFETY: as above.
+            Level::Avx2 => return unsafe { self.row_times_ptr_avx2(p, x) },
+            Level::Generic => {}
         }
         // SAFETY: forwarded from the caller.
         unsafe { row_product!(self, p, x, sym_row_product_scalar) }
@@ -150,7 +155,21 @@ impl Rows32<'_> {
     /// As [`Rows32::row_times_ptr`], and the CPU must have AVX2 and FMA.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
+    #[inline]
     unsafe fn row_times_ptr_avx2(&self, p: usize, x: *const Vec3) -> Vec3 {
+        // SAFETY: forwarded from the caller.
+        unsafe { row_product!(self, p, x, sym_row_product_avx2) }
+    }
+
+    /// [`Rows32::row_times_ptr`] with the AVX2 row product inlined and compiled for AVX-512's
+    /// 32 vector registers (the same instructions otherwise).
+    ///
+    /// # Safety
+    /// As [`Rows32::row_times_ptr`], and the CPU must have the AVX-512 level of [`Level`].
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq,avx512cd")]
+    #[inline]
+    unsafe fn row_times_ptr_avx512(&self, p: usize, x: *const Vec3) -> Vec3 {
         // SAFETY: forwarded from the caller.
         unsafe { row_product!(self, p, x, sym_row_product_avx2) }
     }
@@ -548,9 +567,12 @@ impl Bcsr3 {
     #[inline]
     pub fn row_times(&self, i: usize, x: &[Vec3]) -> Vec3 {
         #[cfg(target_arch = "x86_64")]
-        if super::simd::avx2_fma() {
+        match super::simd::level() {
             // SAFETY: the CPU has the features (checked at run time).
-            return unsafe { self.row_times_avx2(i, x) };
+            Level::Avx512 => return unsafe { self.row_times_avx512(i, x) },
+            // SAFETY: as above.
+            Level::Avx2 => return unsafe { self.row_times_avx2(i, x) },
+            Level::Generic => {}
         }
         self.row_times_any(i, x)
     }
@@ -558,13 +580,22 @@ impl Bcsr3 {
     /// [`Bcsr3::row_times`] compiled for AVX2 and FMA (bit-identical: see [`super::simd`]).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
+    #[inline]
     fn row_times_avx2(&self, i: usize, x: &[Vec3]) -> Vec3 {
+        self.row_times_any(i, x)
+    }
+
+    /// [`Bcsr3::row_times`] compiled for AVX-512 (bit-identical: see [`super::simd`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq,avx512cd")]
+    #[inline]
+    fn row_times_avx512(&self, i: usize, x: &[Vec3]) -> Vec3 {
         self.row_times_any(i, x)
     }
 
     /// [`Bcsr3::row_times`] for whichever CPU features its caller was compiled with.
     #[inline(always)]
-    fn row_times_any(&self, i: usize, x: &[Vec3]) -> Vec3 {
+    pub(crate) fn row_times_any(&self, i: usize, x: &[Vec3]) -> Vec3 {
         let mut acc = Vec3::zeros();
         let (s, e) = (self.row_ptr[i], self.row_ptr[i + 1]);
         if self.sym.is_empty() {

@@ -9,6 +9,8 @@ use rayon::prelude::*;
 
 use super::bcsr::Sym3;
 use super::parallel::{chunks, ordered_sum, SyncPtr, CHUNK};
+#[cfg(target_arch = "x86_64")]
+use super::simd::Level;
 use crate::cloth::buckling::arc_connection::ArcConnection;
 use crate::cloth::elements::material::{Direction, Friction, MaterialLaw};
 use crate::cloth::elements::{BendLine, Hinge, ShearQuad, Spring, SpringKind};
@@ -89,7 +91,8 @@ pub(crate) trait Contribution: Sync {
 
 /// Evaluates every element of `els` in parallel chunks into `blocks`, `g` and the per-chunk
 /// energies `ep`, with friction states `committed` / `trial`; returns the energy, summed in
-/// element order within a chunk and in chunk order across them.
+/// element order within a chunk and in chunk order across them. The loop is compiled twice
+/// and runs its AVX2 form where the CPU has it (bit-identical: see [`super::simd`]).
 pub(crate) fn contribute_all<E: Contribution>(
     els: &[E],
     p: &Pass<'_>,
@@ -99,27 +102,82 @@ pub(crate) fn contribute_all<E: Contribution>(
     committed: &[E::State],
     trial: SyncPtr<E::State>,
 ) -> f64 {
-    els.par_chunks(CHUNK)
-        .zip(blocks.par_chunks_mut(E::BLOCKS * CHUNK))
-        .zip(g.par_chunks_mut(E::TERMS * CHUNK))
-        .zip(ep.par_iter_mut())
-        .enumerate()
-        .for_each(|(c, (((els, bl), g), ep))| {
-            let mut e = 0.0;
-            for k in 0..els.len() {
-                let state = FrictionSlot {
-                    committed,
-                    trial,
-                    index: c * CHUNK + k,
-                };
-                let (t, b) = (E::TERMS * k, E::BLOCKS * k);
-                e +=
-                    els[k].contribute(p, state, &mut g[t..t + E::TERMS], &mut bl[b..b + E::BLOCKS]);
-            }
-            *ep = e;
-        });
-    ordered_sum(&ep[..chunks(els.len(), CHUNK)])
+    #[cfg(target_arch = "x86_64")]
+    match super::simd::level() {
+        // SAFETY: the CPU has the features (checked at run time).
+        Level::Avx512 => {
+            return unsafe { contribute_all_avx512(els, p, blocks, g, ep, committed, trial) }
+        }
+        // SAFETY: as above.
+        Level::Avx2 => {
+            return unsafe { contribute_all_avx2(els, p, blocks, g, ep, committed, trial) }
+        }
+        Level::Generic => {}
+    }
+    contribute_loop!(els, p, blocks, g, ep, committed, trial)
 }
+
+/// [`contribute_all`] compiled for AVX2 and FMA (the closure handed to rayon inherits them).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn contribute_all_avx2<E: Contribution>(
+    els: &[E],
+    p: &Pass<'_>,
+    blocks: &mut [E::Block],
+    g: &mut [Vec3],
+    ep: &mut [f64],
+    committed: &[E::State],
+    trial: SyncPtr<E::State>,
+) -> f64 {
+    contribute_loop!(els, p, blocks, g, ep, committed, trial)
+}
+
+/// [`contribute_all`] compiled for AVX-512.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq,avx512cd")]
+fn contribute_all_avx512<E: Contribution>(
+    els: &[E],
+    p: &Pass<'_>,
+    blocks: &mut [E::Block],
+    g: &mut [Vec3],
+    ep: &mut [f64],
+    committed: &[E::State],
+    trial: SyncPtr<E::State>,
+) -> f64 {
+    contribute_loop!(els, p, blocks, g, ep, committed, trial)
+}
+
+/// The body of [`contribute_all`], written once for both of its forms.
+macro_rules! contribute_loop {
+    ($els:expr, $p:expr, $blocks:expr, $g:expr, $ep:expr, $committed:expr, $trial:expr) => {{
+        let (els, p, ep, committed, trial) = ($els, $p, $ep, $committed, $trial);
+        els.par_chunks(CHUNK)
+            .zip($blocks.par_chunks_mut(E::BLOCKS * CHUNK))
+            .zip($g.par_chunks_mut(E::TERMS * CHUNK))
+            .zip(ep.par_iter_mut())
+            .enumerate()
+            .for_each(|(c, (((els, bl), g), ep))| {
+                let mut e = 0.0;
+                for k in 0..els.len() {
+                    let state = FrictionSlot {
+                        committed,
+                        trial,
+                        index: c * CHUNK + k,
+                    };
+                    let (t, b) = (E::TERMS * k, E::BLOCKS * k);
+                    e += els[k].contribute(
+                        p,
+                        state,
+                        &mut g[t..t + E::TERMS],
+                        &mut bl[b..b + E::BLOCKS],
+                    );
+                }
+                *ep = e;
+            });
+        ordered_sum(&ep[..chunks(els.len(), CHUNK)])
+    }};
+}
+use contribute_loop;
 
 impl Contribution for Spring {
     type State = [f64; 2];
@@ -127,7 +185,7 @@ impl Contribution for Spring {
     const BLOCKS: usize = 1;
     const TERMS: usize = 1;
 
-    #[inline]
+    #[inline(always)]
     fn contribute(
         &self,
         p: &Pass<'_>,
@@ -169,7 +227,7 @@ impl Contribution for ShearQuad {
     const BLOCKS: usize = 2;
     const TERMS: usize = 2;
 
-    #[inline]
+    #[inline(always)]
     fn contribute(
         &self,
         p: &Pass<'_>,
@@ -221,7 +279,7 @@ impl Contribution for BendLine {
     const BLOCKS: usize = 1;
     const TERMS: usize = 3;
 
-    #[inline]
+    #[inline(always)]
     fn contribute(
         &self,
         p: &Pass<'_>,
@@ -295,7 +353,7 @@ impl Contribution for Hinge {
     const BLOCKS: usize = 16;
     const TERMS: usize = 4;
 
-    #[inline]
+    #[inline(always)]
     fn contribute(
         &self,
         p: &Pass<'_>,
@@ -360,7 +418,7 @@ impl Contribution for ArcConnection {
     const BLOCKS: usize = 16;
     const TERMS: usize = 4;
 
-    #[inline]
+    #[inline(always)]
     fn contribute(
         &self,
         p: &Pass<'_>,

@@ -8,6 +8,7 @@ use super::amg::AggregationMultigrid;
 use super::bcsr::Bcsr3;
 use super::multigrid::Multigrid;
 use super::parallel::{chunks, ordered_sum, CHUNK};
+use super::simd::multiversion;
 use crate::cloth::constraints::Filter;
 use crate::geometry::{Mat3, Vec3};
 
@@ -104,19 +105,7 @@ impl PcgWorkspace {
         let bnorm2 = ordered_sum(p1);
         // r = S(b − A Δv), ρ = r·r
         let dvr: &[Vec3] = dv;
-        r.par_chunks_mut(CHUNK)
-            .zip(p2.par_iter_mut())
-            .enumerate()
-            .for_each(|(ci, (rs, pr))| {
-                let mut rr = 0.0;
-                for k in 0..rs.len() {
-                    let i = ci * CHUNK + k;
-                    let ri = filter.apply(i, b[i] - a.row_times(i, dvr));
-                    rr += ri.norm_squared();
-                    rs[k] = ri;
-                }
-                *pr = rr;
-            });
+        filtered_residual(a, filter, b, dvr, r, p2);
         let mut rr = ordered_sum(p2);
         let target = tolerance * tolerance * bnorm2;
         let mut it = 0;
@@ -127,19 +116,7 @@ impl PcgWorkspace {
             while rr > target && it < max_iterations && delta > 0.0 {
                 // q = S A c, cq = c·q
                 let cr: &[Vec3] = c;
-                q.par_chunks_mut(CHUNK)
-                    .zip(p1.par_iter_mut())
-                    .enumerate()
-                    .for_each(|(ci, (qs, p))| {
-                        let mut acc = 0.0;
-                        for k in 0..qs.len() {
-                            let i = ci * CHUNK + k;
-                            let qi = filter.apply(i, a.row_times(i, cr));
-                            acc += cr[i].dot(&qi);
-                            qs[k] = qi;
-                        }
-                        *p = acc;
-                    });
+                filtered_product(a, filter, cr, q, p1);
                 let cq = ordered_sum(p1);
                 if cq <= 0.0 {
                     break;
@@ -183,6 +160,51 @@ impl PcgWorkspace {
             residual,
             converged: rr <= target,
         }
+    }
+}
+
+multiversion! {
+    /// `r = S(b − A x)` and, per chunk of rows, `Σ ‖r_i‖²` into `p2`.
+    fn filtered_residual(
+        a: &Bcsr3,
+        filter: &Filter,
+        b: &[Vec3],
+        x: &[Vec3],
+        r: &mut [Vec3],
+        p2: &mut [f64],
+    ) {
+        r.par_chunks_mut(CHUNK)
+            .zip(p2.par_iter_mut())
+            .enumerate()
+            .for_each(|(ci, (rs, pr))| {
+                let mut rr = 0.0;
+                for k in 0..rs.len() {
+                    let i = ci * CHUNK + k;
+                    let ri = filter.apply(i, b[i] - a.row_times_any(i, x));
+                    rr += ri.norm_squared();
+                    rs[k] = ri;
+                }
+                *pr = rr;
+            });
+    }
+}
+
+multiversion! {
+    /// `q = S A c` and, per chunk of rows, `Σ c_i · q_i` into `p1`.
+    fn filtered_product(a: &Bcsr3, filter: &Filter, c: &[Vec3], q: &mut [Vec3], p1: &mut [f64]) {
+        q.par_chunks_mut(CHUNK)
+            .zip(p1.par_iter_mut())
+            .enumerate()
+            .for_each(|(ci, (qs, p))| {
+                let mut acc = 0.0;
+                for k in 0..qs.len() {
+                    let i = ci * CHUNK + k;
+                    let qi = filter.apply(i, a.row_times_any(i, c));
+                    acc += c[i].dot(&qi);
+                    qs[k] = qi;
+                }
+                *p = acc;
+            });
     }
 }
 

@@ -1,65 +1,94 @@
 //! Run-time CPU-feature dispatch for the solver's hot kernels. The default build is portable
 //! (no `target-cpu=native`), so a binary runs on any CPU of its target; the kernels that gain
-//! from wider vectors are compiled twice with `multiversion!`, generic and with AVX2 and FMA
-//! enabled, and each call takes the AVX2 form when [`avx2_fma`] says the CPU has both.
+//! from wider vectors are compiled three times with `multiversion!`: generic, for AVX2 + FMA
+//! (x86-64-v3), and for AVX-512 (x86-64-v4: 32 vector registers, which the solver's row
+//! products need to stay out of memory); each call takes the best form [`level`] allows.
 //!
-//! Both forms compute bit-identical results: enabling a feature changes the instructions, not
+//! Every form computes bit-identical results: enabling a feature changes the instructions, not
 //! the arithmetic (Rust never contracts `a * b + c` into a fused multiply-add on its own, and
 //! the kernels call no `mul_add`). Setting `EMILION_NO_SIMD=1` in the environment forces the
-//! generic forms, for checking exactly that.
+//! generic forms, `EMILION_NO_SIMD=512` the AVX2 ones at most, for checking exactly that.
 
 use std::sync::atomic::{AtomicU8, Ordering};
 
 /// Name of the environment variable that, set to anything but empty or `0`, forces the generic
-/// forms of the kernels.
+/// forms of the kernels (`512`: forbids the AVX-512 forms only).
 pub const NO_SIMD_VAR: &str = "EMILION_NO_SIMD";
 
-/// Not yet checked / the generic forms / the AVX2 forms.
-const UNKNOWN: u8 = 0;
-const GENERIC: u8 = 1;
-const AVX2_FMA: u8 = 2;
+/// The instruction-set level the kernels run at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Level {
+    /// The target's baseline (SSE2 on x86-64).
+    Generic = 1,
+    /// AVX2 and FMA (x86-64-v3).
+    Avx2 = 2,
+    /// AVX-512 F, VL, BW, DQ and CD on top of AVX2 and FMA (x86-64-v4).
+    Avx512 = 3,
+}
 
-static CHOICE: AtomicU8 = AtomicU8::new(UNKNOWN);
+/// The chosen level; 0 while not yet checked.
+static CHOICE: AtomicU8 = AtomicU8::new(0);
 
-/// Whether the kernels take their AVX2 + FMA forms: the CPU has both features and
-/// `EMILION_NO_SIMD` does not forbid them. Checked once, then read from a cached flag (one
-/// relaxed load per call).
+/// The level the kernels run at: the best the CPU has that `EMILION_NO_SIMD` does not forbid.
+/// Checked once, then read from a cached value (one relaxed load per call).
 #[inline]
-pub fn avx2_fma() -> bool {
+pub fn level() -> Level {
     match CHOICE.load(Ordering::Relaxed) {
-        AVX2_FMA => true,
-        GENERIC => false,
+        1 => Level::Generic,
+        2 => Level::Avx2,
+        3 => Level::Avx512,
         _ => detect(),
     }
 }
 
+/// Whether the kernels take an AVX2 (or better) form.
+#[inline]
+pub fn avx2_fma() -> bool {
+    level() >= Level::Avx2
+}
+
 #[cold]
-fn detect() -> bool {
-    let forbidden = std::env::var_os(NO_SIMD_VAR).is_some_and(|v| !v.is_empty() && v != "0");
-    let yes = !forbidden && cpu_has_avx2_fma();
-    CHOICE.store(if yes { AVX2_FMA } else { GENERIC }, Ordering::Relaxed);
-    yes
+fn detect() -> Level {
+    let var = std::env::var_os(NO_SIMD_VAR).unwrap_or_default();
+    let cap = match var.to_str() {
+        Some("") | Some("0") => Level::Avx512,
+        Some("512") => Level::Avx2,
+        _ => Level::Generic,
+    };
+    let level = cpu_level().min(cap);
+    CHOICE.store(level as u8, Ordering::Relaxed);
+    level
 }
 
 #[cfg(target_arch = "x86_64")]
-fn cpu_has_avx2_fma() -> bool {
-    std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+fn cpu_level() -> Level {
+    use std::arch::is_x86_feature_detected as has;
+    if !(has!("avx2") && has!("fma")) {
+        Level::Generic
+    } else if has!("avx512f")
+        && has!("avx512vl")
+        && has!("avx512bw")
+        && has!("avx512dq")
+        && has!("avx512cd")
+    {
+        Level::Avx512
+    } else {
+        Level::Avx2
+    }
 }
 
 #[cfg(not(target_arch = "x86_64"))]
-fn cpu_has_avx2_fma() -> bool {
-    false
+fn cpu_level() -> Level {
+    Level::Generic
 }
 
-/// Defines a function whose body is compiled twice, generic and with AVX2 and FMA enabled
-/// (x86-64 only), and which runs the AVX2 form when [`avx2_fma`] allows it. Everything the
-/// body inlines, and the closures it defines (they inherit the enabled features), is compiled
-/// for the wider registers too, so a whole loop nest handed to a parallel loop is vectorised;
-/// what it calls that does not inline runs generic.
+/// Defines a function whose body is compiled three times, generic, for AVX2 + FMA and for
+/// AVX-512 (x86-64 only), and which runs the best form [`level`] allows. Everything the body
+/// inlines, and the closures it defines (they inherit the enabled features), is compiled for
+/// the wider registers too, so a whole loop nest handed to a parallel loop is vectorised; what
+/// it calls that does not inline runs generic.
 ///
-/// The function may not be generic and its parameters must be plain names. A method (taking
-/// `&self` or `&mut self`) names its AVX2 twin after a slash, `fn name / name_avx2(&self, ..)`:
-/// the twin is a private method of the same type.
+/// The function may not be generic and its parameters must be plain names.
 ///
 /// ```ignore
 /// multiversion! {
@@ -83,51 +112,19 @@ macro_rules! multiversion {
                 #[target_feature(enable = "avx2,fma")]
                 #[allow(clippy::too_many_arguments)]
                 fn avx2($($arg: $ty),*) $(-> $ret)? $body
-                if $crate::cloth::solver::simd::avx2_fma() {
-                    // SAFETY: the CPU has AVX2 and FMA (checked at run time).
-                    return unsafe { avx2($($arg),*) };
+                #[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq,avx512cd")]
+                #[allow(clippy::too_many_arguments)]
+                fn avx512($($arg: $ty),*) $(-> $ret)? $body
+                match $crate::cloth::solver::simd::level() {
+                    // SAFETY: the CPU has the features (checked at run time).
+                    $crate::cloth::solver::simd::Level::Avx512 => return unsafe { avx512($($arg),*) },
+                    // SAFETY: as above.
+                    $crate::cloth::solver::simd::Level::Avx2 => return unsafe { avx2($($arg),*) },
+                    $crate::cloth::solver::simd::Level::Generic => {}
                 }
             }
             $body
         }
-    };
-    (
-        $(#[$attr:meta])*
-        $vis:vis fn $name:ident / $fast:ident(&mut $s:ident $(, $arg:ident: $ty:ty)* $(,)?)
-        $(-> $ret:ty)? $body:block
-    ) => {
-        $(#[$attr])*
-        $vis fn $name(&mut $s $(, $arg: $ty)*) $(-> $ret)? {
-            #[cfg(target_arch = "x86_64")]
-            if $crate::cloth::solver::simd::avx2_fma() {
-                // SAFETY: the CPU has AVX2 and FMA (checked at run time).
-                return unsafe { $s.$fast($($arg),*) };
-            }
-            $body
-        }
-        #[cfg(target_arch = "x86_64")]
-        #[target_feature(enable = "avx2,fma")]
-        #[allow(clippy::too_many_arguments)]
-        fn $fast(&mut $s $(, $arg: $ty)*) $(-> $ret)? $body
-    };
-    (
-        $(#[$attr:meta])*
-        $vis:vis fn $name:ident / $fast:ident(&$s:ident $(, $arg:ident: $ty:ty)* $(,)?)
-        $(-> $ret:ty)? $body:block
-    ) => {
-        $(#[$attr])*
-        $vis fn $name(&$s $(, $arg: $ty)*) $(-> $ret)? {
-            #[cfg(target_arch = "x86_64")]
-            if $crate::cloth::solver::simd::avx2_fma() {
-                // SAFETY: the CPU has AVX2 and FMA (checked at run time).
-                return unsafe { $s.$fast($($arg),*) };
-            }
-            $body
-        }
-        #[cfg(target_arch = "x86_64")]
-        #[target_feature(enable = "avx2,fma")]
-        #[allow(clippy::too_many_arguments)]
-        fn $fast(&$s $(, $arg: $ty)*) $(-> $ret)? $body
     };
 }
 pub(crate) use multiversion;
