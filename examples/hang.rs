@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use emilion::cloth::{stats, ClothModel, FabricParameters, Simulation, SimulationParameters};
 use emilion::geometry::LookAtCamera;
-use emilion::geometry::{mesh::bounds, write_glb, write_obj};
+use emilion::geometry::{mesh::bounds, write_glb, write_obj, ExportFrame, Units};
 use emilion::render::{render_png, RenderMesh};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -27,8 +27,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &sim.state.x,
         tris,
         Some(&sim.model.mesh.rest),
+        ExportFrame::Y_UP_METRES,
     )?;
-    write_glb(&out.join("hang.glb"), &sim.state.x, tris)?;
+    write_glb(&out.join("hang.glb"), &sim.state.x, tris, Units::Metres)?;
     let (lo, hi) = bounds(&sim.state.x);
     let camera = LookAtCamera::framing(lo, hi, 800, 600);
     let mesh = RenderMesh {

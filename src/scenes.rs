@@ -12,7 +12,7 @@ use crate::contact::{Body, Floor, SimulationContact};
 use crate::geometry::mesh::bounds;
 use crate::geometry::LookAtCamera;
 use crate::geometry::Vec3;
-use crate::geometry::{write_glb, write_obj};
+use crate::geometry::{write_glb, write_obj, ExportFrame, Units};
 use crate::render::{render_png, RenderMesh};
 
 /// The peer benchmark scene: a 1 m × 1 m grid of `n` × `n` particles flat in the XY plane at
@@ -98,9 +98,15 @@ pub fn demo(out_dir: &Path) -> Result<Vec<PathBuf>, ClothError> {
     };
     render_png(&png, &[mesh], &LookAtCamera::framing(lo, hi, 800, 600))?;
     let obj = out_dir.join("demo.obj");
-    write_obj(&obj, x, tris, Some(&sim.model.mesh.rest))?;
+    write_obj(
+        &obj,
+        x,
+        tris,
+        Some(&sim.model.mesh.rest),
+        ExportFrame::Y_UP_METRES,
+    )?;
     let glb = out_dir.join("demo.glb");
-    write_glb(&glb, x, tris)?;
+    write_glb(&glb, x, tris, Units::Metres)?;
     let csv = out_dir.join("demo_stats.csv");
     write_csv(&csv, &sim.stats)?;
     Ok(vec![png, obj, glb, csv])

@@ -34,7 +34,7 @@ use super::sequence_options::FaceSequenceOptions;
 use super::skin::procedural_face_texture;
 use super::FaceError;
 use crate::geometry::Camera;
-use crate::geometry::{write_obj, SplitMix64, Vec3};
+use crate::geometry::{write_obj, ExportFrame, SplitMix64, Vec3};
 
 /// The cameras of a sequence: `n` cameras at yaw angles spread over ±30° (one camera:
 /// frontal), at `distance` from `pivot`, level with it, looking at it.
@@ -157,7 +157,10 @@ pub fn make_face_sequence(
         .iter()
         .map(|t| t.map(|i| i as usize))
         .collect();
-    write_obj(&model_path, &mesh.positions, &tris, Some(&mesh.uvs))
+    // the face model is +Y up already: through the engine's frame and back, exactly
+    let frame = ExportFrame::Y_UP_METRES;
+    let engine: Vec<Vec3> = mesh.positions.iter().map(|p| frame.to_engine(p)).collect();
+    write_obj(&model_path, &engine, &tris, Some(&mesh.uvs), frame)
         .map_err(|e| FaceError::io(&model_path, e))?;
     texture.save(&out.join("truth").join("texture.png"))?;
 

@@ -6,6 +6,7 @@
 pub mod camera;
 pub mod cone;
 pub mod error;
+pub mod export_frame;
 pub mod files;
 pub mod gltf;
 pub mod grid;
@@ -18,6 +19,7 @@ pub mod topology;
 
 pub use camera::{Camera, LookAtCamera};
 pub use error::GeometryError;
+pub use export_frame::{ExportFrame, Units, UpAxis};
 pub use files::photo_files;
 pub use gltf::write_glb;
 pub use grid::grid_mesh;

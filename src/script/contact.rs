@@ -6,16 +6,18 @@ use std::path::Path;
 
 use rhai::{Array, Dynamic, Engine, Map, INT};
 
-use super::convert::{finite, index, indices, rt_err, to_map, update_from_map, vec3, RResult};
+use super::convert::{
+    export_frame, finite, index, indices, rt_err, to_map, update_from_map, vec3, RResult,
+};
 use super::{register, SimHandle};
 use crate::body::RetargetOptions;
-use crate::cloth::ClothError;
+use crate::cloth::{ClothError, Simulation};
 use crate::contact::character::mannequin_body;
 use crate::contact::{
     Body, ContactError, ContactSettings, FrictionCoefficients, MeshBody, SimulationContact,
 };
 use crate::geometry::files::data_path;
-use crate::geometry::{read_obj_surface, Vec3};
+use crate::geometry::{read_obj_surface, ExportFrame, Vec3};
 
 fn contact_err(e: ContactError) -> Box<rhai::EvalAltResult> {
     ClothError::from(e).into()
@@ -31,6 +33,27 @@ fn add_body(h: &SimHandle, body: Result<Body, ContactError>) -> RResult<INT> {
 
 fn v3(d: &Dynamic, what: &str) -> RResult<Vec3> {
     Ok(Vec3::from(vec3(d, what)?))
+}
+
+/// Writes body `b`'s current surface (a mesh body's triangles, or a tessellation of a sphere,
+/// box or plane around the cloth) as OBJ in `frame`.
+fn save_body_obj(sim: &Simulation, b: INT, path: &str, frame: ExportFrame) -> RResult<()> {
+    let n = sim.contact().bodies.len();
+    let body = sim
+        .contact()
+        .bodies
+        .get(index(b, "body")?)
+        .ok_or_else(|| rt_err(format!("body {b} does not exist ({n} bodies)")))?;
+    let (lo, hi) = crate::geometry::mesh::bounds(&sim.state.x);
+    let (p, t) = crate::contact::tessellate::body_mesh(body, &lo, &hi);
+    if let Some(d) = Path::new(path)
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+    {
+        std::fs::create_dir_all(d).map_err(|e| rt_err(format!("{}: {e}", d.display())))?;
+    }
+    crate::geometry::write_obj(Path::new(path), &p, &t, None, frame)?;
+    Ok(())
 }
 
 /// Registers the contact functions of `Simulation`.
@@ -143,19 +166,14 @@ pub fn register(engine: &mut Engine) {
             sim.contact_mut().pin_to_body(index(b, "body")?, &p, &x, Some(snap)).map_err(contact_err)
         });
     register!(engine, "save_body_obj", ["sim: Simulation", "body: int", "path: String"],
-        "Writes a body's current surface (a mesh body's triangles, or a tessellation of a sphere,\nbox or plane around the cloth) as an OBJ file.",
+        "Writes a body's current surface (a mesh body's triangles, or a tessellation of a sphere,\nbox or plane around the cloth) as an OBJ file, +Y up in metres.",
         |h: &mut SimHandle, b: INT, path: &str| -> RResult<()> {
-            let sim = h.get()?;
-            let n = sim.contact().bodies.len();
-            let body = sim.contact().bodies.get(index(b, "body")?)
-                .ok_or_else(|| rt_err(format!("body {b} does not exist ({n} bodies)")))?;
-            let (lo, hi) = crate::geometry::mesh::bounds(&sim.state.x);
-            let (p, t) = crate::contact::tessellate::body_mesh(body, &lo, &hi);
-            if let Some(d) = Path::new(path).parent().filter(|d| !d.as_os_str().is_empty()) {
-                std::fs::create_dir_all(d).map_err(|e| rt_err(format!("{}: {e}", d.display())))?;
-            }
-            crate::geometry::write_obj(Path::new(path), &p, &t, None)?;
-            Ok(())
+            save_body_obj(&*h.get()?, b, path, ExportFrame::Y_UP_METRES)
+        });
+    register!(engine, "save_body_obj", ["sim: Simulation", "body: int", "path: String", "options: Map", "()"],
+        "Writes a body's current surface as an OBJ file with #{up: \"y\" | \"z\", units: \"m\" | \"cm\" |\n\"mm\"} (as `save_obj`).",
+        |h: &mut SimHandle, b: INT, path: &str, m: Map| -> RResult<()> {
+            save_body_obj(&*h.get()?, b, path, export_frame(&m)?)
         });
     register!(engine, "contact_report", ["sim: Simulation", "Map"],
         "Contact state now: #{bodies, min_distance (m, smallest signed vertex–body distance),\npenetrating (vertices inside bodies), intersections (intersecting cloth edge–triangle pairs)}\nand the last step's #{contacts, self_contacts, ccd_hits (continuous cloth–cloth hits),\nzone_rounds (impact-zone rounds), self_stopped (vertices the cloth–cloth response stopped),\ncollision_ms}.",

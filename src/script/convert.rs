@@ -7,7 +7,7 @@ use serde::{de::DeserializeOwned, Serialize};
 use serde_json::Value;
 
 use crate::cloth::ClothError;
-use crate::geometry::GeometryError;
+use crate::geometry::{ExportFrame, GeometryError, Units, UpAxis};
 
 /// Result type of every registered function.
 pub type RResult<T> = Result<T, Box<EvalAltResult>>;
@@ -251,4 +251,27 @@ pub fn doc_comment(text: &str) -> String {
         })
         .collect::<Vec<_>>()
         .join("\n")
+}
+
+/// An export frame from a script options map `#{up: "y" | "z", units: "m" | "cm" | "mm"}`
+/// (each optional: +Y up in metres by default); other keys are errors.
+pub fn export_frame(m: &Map) -> RResult<ExportFrame> {
+    let mut frame = ExportFrame::Y_UP_METRES;
+    for (k, v) in m {
+        let text = || {
+            v.clone()
+                .into_string()
+                .map_err(|_| rt_err(format!("`{k}` must be a string")))
+        };
+        match k.as_str() {
+            "up" => frame.up = UpAxis::parse(&text()?).map_err(rt_err)?,
+            "units" => frame.units = Units::parse(&text()?).map_err(rt_err)?,
+            _ => {
+                return Err(rt_err(format!(
+                    "unknown export option `{k}` (known: up, units)"
+                )))
+            }
+        }
+    }
+    Ok(frame)
 }

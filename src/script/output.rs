@@ -5,13 +5,13 @@ use std::path::Path;
 
 use rhai::{Array, Dynamic, Engine, Map, INT};
 
-use super::convert::{arr3, count, finite, rt_err, to_map, RResult};
+use super::convert::{arr3, count, export_frame, finite, rt_err, to_map, RResult};
 use super::{register, SimHandle};
 use crate::cloth::{stats, Simulation};
 use crate::contact::tessellate::body_mesh;
 use crate::contact::SimulationContact;
 use crate::geometry::LookAtCamera;
-use crate::geometry::{mesh::bounds, write_glb, write_obj};
+use crate::geometry::{mesh::bounds, write_glb, write_obj, ExportFrame, UpAxis};
 use crate::render::{render_png, RenderMesh};
 
 /// Creates the parent folder of an output file.
@@ -92,6 +92,31 @@ fn render(sim: &Simulation, path: &str, cam: &LookAtCamera) -> RResult<()> {
     Ok(())
 }
 
+/// Writes the cloth as OBJ in `frame`.
+fn save_obj(s: &Simulation, path: &str, frame: ExportFrame) -> RResult<()> {
+    parent_dir(path)?;
+    let (x, m) = (&s.state.x, &s.model.mesh);
+    write_obj(Path::new(path), x, &m.triangles, Some(&m.rest), frame)?;
+    Ok(())
+}
+
+/// Writes the cloth as binary glTF in `frame` (which must be +Y up).
+fn save_glb(s: &Simulation, path: &str, frame: ExportFrame) -> RResult<()> {
+    if frame.up != UpAxis::Y {
+        return Err(rt_err(format!(
+            "{path}: glTF is +Y up by its specification"
+        )));
+    }
+    parent_dir(path)?;
+    write_glb(
+        Path::new(path),
+        &s.state.x,
+        &s.model.mesh.triangles,
+        frame.units,
+    )?;
+    Ok(())
+}
+
 /// Registers the read-out and output methods of `Simulation`.
 pub fn register(engine: &mut Engine) {
     register!(
@@ -152,25 +177,29 @@ pub fn register(engine: &mut Engine) {
             Ok(h.get()?.stats.last().map(to_map).unwrap_or_else(|| Dynamic::from_map(Map::new())))
         });
     register!(engine, "save_obj", ["sim: Simulation", "path: String"],
-        "Writes the current shape as OBJ, with the rest (pattern) coordinates as texture coordinates.",
+        "Writes the current shape as OBJ, +Y up in metres (as Blender and Maya read OBJ), with the\nrest (pattern) coordinates as texture coordinates.",
         |h: &mut SimHandle, path: &str| -> RResult<()> {
-            parent_dir(path)?;
-            let s = h.get()?;
-            write_obj(Path::new(path), &s.state.x, &s.model.mesh.triangles, Some(&s.model.mesh.rest))?;
-            Ok(())
+            save_obj(&*h.get()?, path, ExportFrame::Y_UP_METRES)
+        });
+    register!(engine, "save_obj", ["sim: Simulation", "path: String", "options: Map", "()"],
+        "Writes the current shape as OBJ with #{up: \"y\" (default) | \"z\", units: \"m\" (default) |\n\"cm\" | \"mm\"}.",
+        |h: &mut SimHandle, path: &str, m: Map| -> RResult<()> {
+            save_obj(&*h.get()?, path, export_frame(&m)?)
         });
     register!(
         engine,
         "save_glb",
         ["sim: Simulation", "path: String"],
-        "Writes the current shape as binary glTF (.glb).",
+        "Writes the current shape as binary glTF (.glb): +Y up (glTF's frame), metres.",
         |h: &mut SimHandle, path: &str| -> RResult<()> {
-            parent_dir(path)?;
-            let s = h.get()?;
-            write_glb(Path::new(path), &s.state.x, &s.model.mesh.triangles)?;
-            Ok(())
+            save_glb(&*h.get()?, path, ExportFrame::Y_UP_METRES)
         }
     );
+    register!(engine, "save_glb", ["sim: Simulation", "path: String", "options: Map", "()"],
+        "Writes the current shape as binary glTF (.glb) with #{units: \"m\" | \"cm\" | \"mm\"} (glTF is\nalways +Y up; `up` other than \"y\" is an error).",
+        |h: &mut SimHandle, path: &str, m: Map| -> RResult<()> {
+            save_glb(&*h.get()?, path, export_frame(&m)?)
+        });
     register!(
         engine,
         "save_stats_csv",

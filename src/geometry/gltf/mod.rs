@@ -22,6 +22,7 @@ use gltf_json::mesh::MorphTarget;
 use gltf_json::texture::{Info, MinFilter};
 use gltf_json::{Accessor, Index, Material, Root, Texture};
 
+use crate::geometry::export_frame::{ExportFrame, Units, UpAxis};
 use crate::geometry::files::check_mesh;
 use crate::geometry::mesh::vertex_normals;
 use crate::geometry::{GeometryError, Vec3};
@@ -270,9 +271,10 @@ fn glb_material(m: &GlbMaterial, texture: Option<Index<Texture>>) -> Material {
     }
 }
 
-/// Writes a triangle mesh as binary glTF 2.0 (`.glb`) through [`write_glb_mesh`]: one
+/// Writes a triangle mesh of the engine (metres, +Z up) as binary glTF 2.0 (`.glb`) through
+/// [`write_glb_mesh`], in glTF's frame (+Y up: see [`ExportFrame`]) scaled to `units`: one
 /// primitive with `POSITION` (f32, with min/max), `NORMAL` (f32, area-weighted vertex normals,
-/// `+z` where a vertex has none) and `u32` indices, and one double-sided, rough,
+/// `+y` where a vertex has none) and `u32` indices, and one double-sided, rough,
 /// non-metallic fabric material. Parent folders are created; the file is written to a
 /// temporary file and renamed, so a failure never leaves a half-written file.
 ///
@@ -283,7 +285,12 @@ pub fn write_glb(
     path: &Path,
     positions: &[Vec3],
     triangles: &[[usize; 3]],
+    units: Units,
 ) -> Result<(), GeometryError> {
+    let frame = ExportFrame {
+        up: UpAxis::Y,
+        units,
+    };
     let invalid = |m: String| GeometryError::Invalid(format!("{}: {m}", path.display()));
     check_mesh(path, positions, triangles)?;
     if positions.is_empty() || triangles.is_empty() {
@@ -299,16 +306,20 @@ pub fn write_glb(
     }
     let p32: Vec<[f32; 3]> = positions
         .iter()
-        .map(|p| [p.x as f32, p.y as f32, p.z as f32])
+        .map(|p| {
+            let q = frame.point(p);
+            [q.x as f32, q.y as f32, q.z as f32]
+        })
         .collect();
     let normals: Vec<[f32; 3]> = vertex_normals(positions, triangles)
         .iter()
         .map(|nv| {
             let unit = nv.iter().all(|c| c.is_finite()) && (nv.norm() - 1.0).abs() < 1e-3;
             if unit {
-                [nv.x as f32, nv.y as f32, nv.z as f32]
+                let d = frame.direction(nv);
+                [d.x as f32, d.y as f32, d.z as f32]
             } else {
-                [0.0, 0.0, 1.0]
+                [0.0, 1.0, 0.0]
             }
         })
         .collect();
@@ -367,7 +378,7 @@ mod tests {
         let g = grid_mesh(1.0, 0.5, 4, 3).unwrap();
         let dir = std::env::temp_dir().join(format!("emilion-glb-{}", std::process::id()));
         let path = dir.join("out").join("grid.glb");
-        write_glb(&path, &g.positions, &g.triangles).unwrap();
+        write_glb(&path, &g.positions, &g.triangles, Units::Metres).unwrap();
         let b = std::fs::read(&path).unwrap();
         assert_eq!(&b[0..4], b"glTF");
         assert_eq!(u32_at(&b, 4), 2);
@@ -380,8 +391,9 @@ mod tests {
         assert_eq!(acc[0]["count"], g.positions.len());
         assert_eq!(acc[1]["count"], g.positions.len());
         assert_eq!(acc[2]["count"], 3 * g.triangles.len());
-        assert_eq!(acc[0]["min"], serde_json::json!([-0.5, -0.25, 0.0]));
-        assert_eq!(acc[0]["max"], serde_json::json!([0.5, 0.25, 0.0]));
+        // the engine's xy-plane is glTF's xz-plane (+Y up), engine +y along glTF −z
+        assert_eq!(acc[0]["min"], serde_json::json!([-0.5, 0.0, -0.25]));
+        assert_eq!(acc[0]["max"], serde_json::json!([0.5, 0.0, 0.25]));
         assert_eq!(json["materials"][0]["doubleSided"], true);
         let bin_at = 20 + json_len;
         let bin_len = u32_at(&b, bin_at) as usize;
@@ -407,7 +419,9 @@ mod tests {
             (&p[..], &[[0, 1, 5]][..]),
             (&[Vec3::repeat(1e300), p[1], p[2]][..], &[[0, 1, 2]][..]),
         ] {
-            let e = write_glb(&path, pos, tri).unwrap_err().to_string();
+            let e = write_glb(&path, pos, tri, Units::Metres)
+                .unwrap_err()
+                .to_string();
             assert!(e.contains("emilion-glb-bad"), "{e}");
         }
         assert!(!path.exists());

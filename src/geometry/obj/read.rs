@@ -298,6 +298,7 @@ mod tests {
     use super::*;
     use crate::geometry::grid_mesh;
     use crate::geometry::obj::write_obj;
+    use crate::geometry::ExportFrame;
 
     fn tmp(name: &str) -> std::path::PathBuf {
         std::env::temp_dir().join(format!("emilion-obj-{}-{name}", std::process::id()))
@@ -307,7 +308,14 @@ mod tests {
     fn write_then_read_grid() {
         let g = grid_mesh(1.0, 0.5, 4, 3).unwrap();
         let path = tmp("dir").join("sub").join("grid.obj");
-        write_obj(&path, &g.positions, &g.triangles, Some(&g.rest)).unwrap();
+        write_obj(
+            &path,
+            &g.positions,
+            &g.triangles,
+            Some(&g.rest),
+            ExportFrame::ENGINE,
+        )
+        .unwrap();
         let back = read_obj(&path).unwrap();
         // Same numbering, and f64 values survive the text round trip exactly.
         assert_eq!(back.triangles, g.triangles);

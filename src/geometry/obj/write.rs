@@ -6,6 +6,7 @@
 use std::ops::Range;
 use std::path::Path;
 
+use crate::geometry::export_frame::ExportFrame;
 use crate::geometry::files::{check_mesh, write_atomic};
 use crate::geometry::mesh::vertex_normals;
 use crate::geometry::{GeometryError, Vec3};
@@ -155,7 +156,9 @@ fn check_obj_mesh(mesh: &ObjMesh) -> Result<(), String> {
     Ok(())
 }
 
-/// Writes a cloth's shape as Wavefront OBJ through [`write_obj_mesh`]: `v` positions, `vt`
+/// Writes a cloth's shape (engine frame: metres, +Z up) as Wavefront OBJ in the file frame
+/// `frame` (see [`ExportFrame`]; +Y up in metres is what Blender and Maya expect) through
+/// [`write_obj_mesh`]: `v` positions, `vt`
 /// rest coordinates (metres, when `rest` is given), `vn` area-weighted vertex normals (zero
 /// where a vertex has none), and `f a/a/a` faces (1-based; `f a//a` without rest
 /// coordinates). Parent folders are created; the file is written to a temporary file and
@@ -168,6 +171,7 @@ pub fn write_obj(
     positions: &[Vec3],
     triangles: &[[usize; 3]],
     rest: Option<&[[f64; 2]]>,
+    frame: ExportFrame,
 ) -> Result<(), GeometryError> {
     check_mesh(path, positions, triangles)?;
     if let Some(rest) = rest {
@@ -191,17 +195,21 @@ pub fn write_obj(
         .into_iter()
         .map(|n| {
             if n.iter().all(|c| c.is_finite()) {
-                n
+                frame.direction(&n)
             } else {
                 Vec3::zeros()
             }
         })
         .collect();
-    let mut comments = vec![format!(
-        "emilion cloth mesh: {} vertices, {} triangles",
-        positions.len(),
-        triangles.len()
-    )];
+    let file_positions: Vec<Vec3> = positions.iter().map(|p| frame.point(p)).collect();
+    let mut comments = vec![
+        format!(
+            "emilion cloth mesh: {} vertices, {} triangles",
+            positions.len(),
+            triangles.len()
+        ),
+        frame.describe(),
+    ];
     if rest.is_some() {
         comments.push("vt: rest (pattern) coordinates in metres, u = warp, v = weft".into());
     }
@@ -209,7 +217,7 @@ pub fn write_obj(
         path,
         &ObjMesh {
             comments: &comments,
-            positions,
+            positions: &file_positions,
             uvs: rest.unwrap_or(&[]),
             normals: &normals,
             triangles,
@@ -230,13 +238,20 @@ mod tests {
     fn write_rejects_bad_input_without_touching_the_file() {
         let path = tmp("bad.obj");
         let p = [Vec3::zeros(), Vec3::x(), Vec3::y()];
-        let e = write_obj(&path, &p, &[[0, 1, 3]], None)
+        let e = write_obj(&path, &p, &[[0, 1, 3]], None, ExportFrame::ENGINE)
             .unwrap_err()
             .to_string();
         assert!(e.contains("bad.obj") && e.contains("out of range"), "{e}");
         let nan = [Vec3::zeros(), Vec3::x(), Vec3::new(f64::NAN, 0.0, 0.0)];
-        assert!(write_obj(&path, &nan, &[[0, 1, 2]], None).is_err());
-        assert!(write_obj(&path, &p, &[[0, 1, 2]], Some(&[[0.0, 0.0]])).is_err());
+        assert!(write_obj(&path, &nan, &[[0, 1, 2]], None, ExportFrame::ENGINE).is_err());
+        assert!(write_obj(
+            &path,
+            &p,
+            &[[0, 1, 2]],
+            Some(&[[0.0, 0.0]]),
+            ExportFrame::ENGINE
+        )
+        .is_err());
         assert!(!path.exists());
     }
 
