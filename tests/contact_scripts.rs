@@ -9,9 +9,19 @@ mod support;
 
 use std::path::{Path, PathBuf};
 
-use emilion::geometry::{read_obj, TriMesh};
+use emilion::geometry::{read_obj, ExportFrame, TriMesh};
 
 /// Vertices and triangles of an OBJ without texture coordinates (a body mesh).
+/// A cloth OBJ written by a script (+Y up, metres), back in the engine's frame (+Z up).
+fn read_cloth(path: &Path) -> TriMesh {
+    let mut m = read_obj(path).unwrap();
+    for p in m.positions.iter_mut() {
+        *p = ExportFrame::Y_UP_METRES.to_engine(p);
+    }
+    m
+}
+
+/// A body OBJ (positions and faces only, +Y up), back in the engine's frame.
 fn read_plain_obj(path: &Path) -> TriMesh {
     let text = std::fs::read_to_string(path).unwrap();
     let mut m = TriMesh::default();
@@ -20,8 +30,8 @@ fn read_plain_obj(path: &Path) -> TriMesh {
         match it.next() {
             Some("v") => {
                 let c: Vec<f64> = it.take(3).map(|s| s.parse().unwrap()).collect();
-                m.positions
-                    .push(emilion::geometry::Vec3::new(c[0], c[1], c[2]));
+                let p = emilion::geometry::Vec3::new(c[0], c[1], c[2]);
+                m.positions.push(ExportFrame::Y_UP_METRES.to_engine(&p));
             }
             Some("f") => {
                 let c: Vec<usize> = it
@@ -91,7 +101,7 @@ fn no_self_intersection(m: &TriMesh, what: &str) {
 fn drape_sphere_no_penetration_no_intersection() {
     let dir = run("drape_sphere", &[]);
     assert_eq!(frames(&dir), 10);
-    let cloth = read_obj(&dir.join("drape_sphere.obj")).unwrap();
+    let cloth = read_cloth(&dir.join("drape_sphere.obj"));
     let worst = cloth
         .positions
         .iter()
@@ -111,7 +121,7 @@ fn drape_sphere_no_penetration_no_intersection() {
 fn drape_table_no_penetration_no_intersection() {
     let dir = run("drape_table", &[]);
     assert_eq!(frames(&dir), 8);
-    let cloth = read_obj(&dir.join("drape_table.obj")).unwrap();
+    let cloth = read_cloth(&dir.join("drape_table.obj"));
     for p in &cloth.positions {
         let inside_table = p.x.abs() < 0.4 && p.y.abs() < 0.4 && p.z > 0.0 && p.z < 0.75;
         assert!(
@@ -132,7 +142,7 @@ fn drape_table_no_penetration_no_intersection() {
 fn self_fold_lands_on_itself_without_intersection() {
     let dir = run("self_fold", &[]);
     assert_eq!(frames(&dir), 12);
-    let cloth = read_obj(&dir.join("self_fold.obj")).unwrap();
+    let cloth = read_cloth(&dir.join("self_fold.obj"));
     assert!(
         cloth.positions.iter().all(|p| p.z >= 0.0),
         "a vertex is under the floor"
@@ -160,7 +170,7 @@ fn mannequin_walk_two_seconds_without_penetration() {
     let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data");
     let dir = run("mannequin_walk", &[("data", data)]);
     assert_eq!(frames(&dir), 10);
-    let skirt = read_obj(&dir.join("skirt.obj")).unwrap();
+    let skirt = read_cloth(&dir.join("skirt.obj"));
     let body = read_plain_obj(&dir.join("mannequin.obj"));
     let pts = points(&body);
     let inside: Vec<usize> = skirt

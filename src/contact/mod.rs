@@ -15,6 +15,7 @@ pub mod impact_zone;
 pub mod mesh_body;
 pub mod primitives;
 pub mod proximity;
+pub mod recording;
 pub mod self_collision;
 pub mod spatial_hash;
 pub mod stage;

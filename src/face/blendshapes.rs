@@ -227,6 +227,7 @@ pub fn write_arkit_glb(
         indices: &indices,
         primitives: &primitives,
         texture: None,
+        animation: None,
     };
     write_glb_mesh(path, &glb).map_err(|e| FaceError::Failed(e.to_string()))?;
     let mut csv = String::from("name,max_displacement_m,vertex\n");

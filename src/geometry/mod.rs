@@ -3,6 +3,7 @@
 //! ([`camera`]), the Levenberg–Marquardt solver ([`least_squares`]), grey images and their
 //! filters ([`image`]) and seeded random numbers ([`random`]).
 
+pub mod animation;
 pub mod camera;
 pub mod cone;
 pub mod error;
@@ -14,8 +15,10 @@ pub mod image;
 pub mod least_squares;
 pub mod mesh;
 pub mod obj;
+pub mod pc2;
 pub mod random;
 pub mod topology;
+pub mod usd;
 
 pub use camera::{Camera, LookAtCamera};
 pub use error::GeometryError;

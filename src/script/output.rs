@@ -8,6 +8,7 @@ use rhai::{Array, Dynamic, Engine, Map, INT};
 use super::convert::{arr3, count, export_frame, finite, rt_err, to_map, RResult};
 use super::{register, SimHandle};
 use crate::cloth::{stats, Simulation};
+use crate::contact::recording::{CacheFormat, Recording};
 use crate::contact::tessellate::body_mesh;
 use crate::contact::SimulationContact;
 use crate::geometry::LookAtCamera;
@@ -117,6 +118,45 @@ fn save_glb(s: &Simulation, path: &str, frame: ExportFrame) -> RResult<()> {
     Ok(())
 }
 
+/// Starts recording `h` into `path` with `#{format, fps, up, units}` (see `record`).
+fn record(h: &SimHandle, path: &str, m: &Map) -> RResult<()> {
+    let mut frame_opts = m.clone();
+    let format = match frame_opts.remove("format") {
+        Some(f) => {
+            let f = f
+                .into_string()
+                .map_err(|_| rt_err("`format` must be a string"))?;
+            CacheFormat::parse(&f).map_err(rt_err)?
+        }
+        None => CacheFormat::from_path(Path::new(path)).ok_or_else(|| {
+            rt_err(format!(
+                "{path}: give `format` (\"usd\", \"pc2\" or \"glb\") or a .usda, .pc2 or .glb path"
+            ))
+        })?,
+    };
+    let fps = match frame_opts.remove("fps") {
+        Some(v) => finite(&v, "fps")?,
+        None => 24.0,
+    };
+    let frame = export_frame(&frame_opts)?;
+    let frame = match (format, frame_opts.contains_key("up")) {
+        // USD declares its up axis: the engine's own frame unless asked otherwise
+        (CacheFormat::Usd, false) => ExportFrame {
+            up: UpAxis::Z,
+            ..frame
+        },
+        _ => frame,
+    };
+    parent_dir(path)?;
+    let rec = Recording::start(&*h.get()?, path.into(), format, frame, fps)?;
+    let mut recs =
+        h.1.try_borrow_mut()
+            .map_err(|_| rt_err("the recording is busy"))?;
+    recs.retain(|r| r.path != rec.path);
+    recs.push(rec);
+    Ok(())
+}
+
 /// Registers the read-out and output methods of `Simulation`.
 pub fn register(engine: &mut Engine) {
     register!(
@@ -200,6 +240,28 @@ pub fn register(engine: &mut Engine) {
         |h: &mut SimHandle, path: &str, m: Map| -> RResult<()> {
             save_glb(&*h.get()?, path, export_frame(&m)?)
         });
+    register!(engine, "record", ["sim: Simulation", "path: String", "options: Map", "()"],
+        "Starts recording the simulation as an animation cache (beside any other recording; the same\npath again starts that one over): the current state is frame 0 and frame k the state after k frames of `run_frames`; the file is (re)written at the end of each `run_frames`.\nThe cloth and every mesh body (a mannequin) are recorded. Options: #{format: \"usd\" (a .usda\nstage, +Z up unless `up` says otherwise) | \"pc2\" (one point cache and rest OBJ per mesh) |\n\"glb\" (morph-target animation), by default from the extension; fps: frames per second\n(24, use run_frames' rate); up: \"y\" | \"z\"; units: \"m\" | \"cm\" | \"mm\"}.",
+        |h: &mut SimHandle, path: &str, m: Map| -> RResult<()> { record(h, path, &m) });
+    register!(
+        engine,
+        "record",
+        ["sim: Simulation", "path: String", "()"],
+        "Starts recording the simulation into `path` (.usda, .pc2 or .glb), 24 frames per second.",
+        |h: &mut SimHandle, path: &str| -> RResult<()> { record(h, path, &Map::new()) }
+    );
+    register!(
+        engine,
+        "save_recording",
+        ["sim: Simulation", "Array"],
+        "Writes every recording now (nothing without one); returns the paths of the files written.",
+        |h: &mut SimHandle| -> RResult<Array> {
+            Ok(h.write_recording()?
+                .iter()
+                .map(|p| Dynamic::from(p.display().to_string()))
+                .collect())
+        }
+    );
     register!(
         engine,
         "save_stats_csv",

@@ -14,16 +14,49 @@ use super::convert::{
 };
 use super::{function, getter, modules::ApiBuilder, register, ClothHandle};
 use crate::cloth::{Simulation, SimulationParameters, Trajectory};
+use crate::contact::recording::Recording;
 use crate::contact::{Floor, SimulationContact};
 
-/// A simulation as a script handle: every copy refers to the same simulation.
+/// A simulation as a script handle: every copy refers to the same simulation (and to the same
+/// animation recordings, when some were started).
 #[derive(Debug, Clone)]
-pub struct SimHandle(pub Shared<Locked<Simulation>>);
+pub struct SimHandle(
+    pub Shared<Locked<Simulation>>,
+    pub Shared<Locked<Vec<Recording>>>,
+);
 
 impl SimHandle {
     /// Wraps a simulation.
     pub fn new(sim: Simulation) -> Self {
-        SimHandle(Shared::new(Locked::new(sim)))
+        SimHandle(
+            Shared::new(Locked::new(sim)),
+            Shared::new(Locked::new(Vec::new())),
+        )
+    }
+
+    /// Adds the simulation's current state to every recording started.
+    pub fn capture_frame(&self) -> RResult<()> {
+        let mut recs = self
+            .1
+            .try_borrow_mut()
+            .map_err(|_| rt_err("the recording is busy"))?;
+        for r in recs.iter_mut() {
+            r.capture(&*self.get()?)?;
+        }
+        Ok(())
+    }
+
+    /// Writes every recording started; returns the files written.
+    pub fn write_recording(&self) -> RResult<Vec<std::path::PathBuf>> {
+        let recs = self
+            .1
+            .try_borrow()
+            .map_err(|_| rt_err("the recording is busy"))?;
+        let mut written = Vec::new();
+        for r in recs.iter() {
+            written.extend(r.write()?);
+        }
+        Ok(written)
     }
     /// Reads the simulation.
     pub fn get(&self) -> RResult<Ref<'_, Simulation>> {
@@ -343,7 +376,7 @@ up/down choice on a flat cloth (one side of the cloth per step for all its ties)
             Ok(())
         });
     register!(engine, "run_frames", ["sim: Simulation", "frames: int", "fps: float", "callback: FnPtr"],
-        "Runs `frames` frames at `fps`, stepping to each frame time and then calling\n`callback(#{frame, time, step, sim})` (`frame` from 1). A callback returning `false` stops the run.\nInside the callback the simulation is `this` (or `t.sim`); Rhai forbids capturing `sim` itself.",
+        "Runs `frames` frames at `fps`, stepping to each frame time and then calling\n`callback(#{frame, time, step, sim})` (`frame` from 1). A callback returning `false` stops the run.\nWith a recording started (`record`), each frame is added to it and the cache is written at the end.\nInside the callback the simulation is `this` (or `t.sim`); Rhai forbids capturing `sim` itself.",
         |ctx: NativeCallContext, h: &mut SimHandle, frames: INT, fps: Dynamic, f: FnPtr| -> RResult<()> {
             let frames = count(&Dynamic::from_int(frames), "frames")? as u64;
             let fps = finite(&fps, "fps")?;
@@ -358,10 +391,12 @@ up/down choice on a flat cloth (one side of the cloth per step for all its ties)
                     s.run_steps(n, |_, _| Ok(()))?;
                     frame_info(k, &s, h)
                 };
+                h.capture_frame()?;
                 if !callback(&ctx, h, &f, info)? {
                     break;
                 }
             }
+            h.write_recording()?;
             Ok(())
         });
 

@@ -12,6 +12,9 @@
 
 mod document;
 
+mod animation;
+pub use animation::write_animated_glb;
+
 use std::ops::Range;
 use std::path::Path;
 
@@ -95,6 +98,18 @@ pub struct GlbMesh<'a> {
     pub primitives: &'a [GlbPrimitive],
     /// The texture of the textured materials.
     pub texture: Option<GlbTexture<'a>>,
+    /// An animation of the morph-target weights, if any.
+    pub animation: Option<GlbWeightsAnimation<'a>>,
+}
+
+/// Key frames of the mesh's morph-target weights, interpolated linearly: at `times[k]` the
+/// weights are `weights[k·T .. (k+1)·T]` for `T` targets.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GlbWeightsAnimation<'a> {
+    /// Key times (s), increasing.
+    pub times: &'a [f32],
+    /// The weights of every target at every key time, time-major.
+    pub weights: &'a [f32],
 }
 
 /// Writes `mesh` as binary glTF 2.0: one scene, one node, one mesh with a primitive per
@@ -136,6 +151,10 @@ pub fn write_glb_mesh(path: &Path, mesh: &GlbMesh) -> Result<(), GeometryError> 
     let uv_at = mesh
         .uvs
         .map(|uvs| floats(&mut bin, &mut uvs.iter().flatten()));
+    let anim_at = mesh.animation.map(|a| {
+        let times = floats(&mut bin, &mut a.times.iter());
+        (times, floats(&mut bin, &mut a.weights.iter()))
+    });
     let idx_at = bin.len() as u64;
     mesh.indices
         .iter()
@@ -207,8 +226,58 @@ pub fn write_glb_mesh(path: &Path, mesh: &GlbMesh) -> Result<(), GeometryError> 
             glb_triangles(pos_acc, nrm_acc, uv_acc, indices, material, targets)
         })
         .collect();
+    if let (Some(a), Some((times_at, weights_at))) = (mesh.animation, anim_at) {
+        push_weights_animation(&mut root, buffer, a, times_at, weights_at);
+    }
     let names: Vec<&str> = mesh.morph_targets.iter().map(|t| t.name).collect();
     finish_glb(path, root, primitives, &names, bin)
+}
+
+/// Adds the animation of the (first and only) node's weights, whose key times and weights lie
+/// at `times_at` and `weights_at` of the buffer.
+fn push_weights_animation(
+    root: &mut Root,
+    buffer: Index<gltf_json::Buffer>,
+    a: GlbWeightsAnimation,
+    times_at: u64,
+    weights_at: u64,
+) {
+    use gltf_json::animation::{Channel, Interpolation, Property, Sampler, Target as AnimTarget};
+    use gltf_json::validation::Checked::Valid;
+    let nt = a.times.len() as u64;
+    let view = root.push(glb_view(buffer, times_at, 4 * nt, None));
+    let (t0, t1) = (a.times[0], a.times[a.times.len() - 1]);
+    let input = root.push(Accessor {
+        min: Some(serde_json::json!([t0])),
+        max: Some(serde_json::json!([t1])),
+        ..glb_accessor(view, nt, ComponentType::F32, Type::Scalar)
+    });
+    let nw = a.weights.len() as u64;
+    let view = root.push(glb_view(buffer, weights_at, 4 * nw, None));
+    let output = root.push(glb_accessor(view, nw, ComponentType::F32, Type::Scalar));
+    let sampler = Index::new(0);
+    root.animations.push(gltf_json::Animation {
+        extensions: None,
+        extras: Default::default(),
+        channels: vec![Channel {
+            sampler,
+            target: AnimTarget {
+                extensions: None,
+                extras: Default::default(),
+                node: Index::new(0),
+                path: Valid(Property::MorphTargetWeights),
+            },
+            extensions: None,
+            extras: Default::default(),
+        }],
+        samplers: vec![Sampler {
+            extensions: None,
+            extras: Default::default(),
+            input,
+            interpolation: Valid(Interpolation::Linear),
+            output,
+        }],
+    });
 }
 
 /// Checks what [`write_glb_mesh`] needs of a mesh, saying what is wrong.
@@ -247,6 +316,19 @@ fn check_glb_mesh(mesh: &GlbMesh) -> Result<(), String> {
             mesh.primitives[k].indices,
             mesh.indices.len()
         ));
+    }
+    if let Some(a) = &mesh.animation {
+        let nt = mesh.morph_targets.len();
+        if a.times.is_empty() || a.weights.len() != a.times.len() * nt || nt == 0 {
+            return Err(format!(
+                "animation of {} key times and {} weights for {nt} morph targets",
+                a.times.len(),
+                a.weights.len()
+            ));
+        }
+        if !a.times.windows(2).all(|w| w[0] < w[1]) || !a.times.iter().all(|t| t.is_finite()) {
+            return Err("animation key times must be finite and increasing".into());
+        }
     }
     Ok(())
 }
