@@ -10,7 +10,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use emilion::garment::{read_garment, read_pattern_dxf, Outline, Pattern, Segment, P2};
+use emilion::garment::{
+    read_garment, read_pattern_dxf, write_pattern_json, Outline, Pattern, Segment, P2,
+};
 use emilion::script::run_file;
 
 /// 0.01 mm, the acceptance tolerance on coordinates (m).
@@ -196,6 +198,37 @@ fn aaron_round_trips_through_dxf_from_a_script() {
     }
     let mm = run_script(&source, "aaron", "mm");
     ezdxf_check(&mm.join("aaron.dxf"), &original, 1000.0, 4);
+}
+
+#[test]
+fn notches_on_curves_and_lines_round_trip() {
+    // The A-shirt (no notches of its own) with a notch on each piece's first curve, at a third
+    // of its parameter, and one in the middle of its first straight edge, as a JSON pattern.
+    let mut original = read_garment(&root().join("scripts/patterns/aaron.garment.json")).unwrap();
+    for piece in &mut original.pieces {
+        let cs = piece.outline.corners.clone();
+        let n = cs.len();
+        let on = |kind: bool| {
+            let i = (0..n)
+                .find(|&i| (cs[i].segment == Segment::Line) == kind)
+                .unwrap();
+            cs[i].segment.point(
+                cs[i].at,
+                cs[(i + 1) % n].at,
+                if kind { 0.5 } else { 1.0 / 3.0 },
+            )
+        };
+        piece.notches = vec![on(false), on(true)];
+    }
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("pattern_to_dxf_notched");
+    std::fs::create_dir_all(&dir).unwrap();
+    let json = dir.join("notched.json");
+    write_pattern_json(&original, &json).unwrap();
+    let out = run_script(&json, "notched", "mm");
+    let back = read_pattern_dxf(&out.join("notched.dxf")).unwrap();
+    let w = assert_same(&original, &back, "notched aaron (mm)");
+    println!("notched aaron (mm): worst notch {:.2e} mm", w[2] * 1e3);
+    ezdxf_check(&out.join("notched.dxf"), &original, 1000.0, 4);
 }
 
 #[test]

@@ -22,8 +22,10 @@
 //!   from the sew line to the boundary along the sew line's outward normal, over the parts
 //!   where they differ (a fold or an edge without allowance counts for nothing).
 //! - Layer 2 turn points and 3 curve points (POINTs within 0.1 mm of the outline). The
-//!   corners are the turn points; between two, the polyline becomes a straight line, or one
-//!   cubic Bézier fitted by least squares when one follows every vertex within 0.05 mm; else
+//!   corners are the turn points (the outline's vertex within 0.1 mm of one moves onto it);
+//!   between two, the polyline becomes a straight line, or one cubic Bézier fitted by least
+//!   squares (from chord-length and from even parameters, the better fit kept) when one
+//!   follows every vertex within 0.05 mm; else
 //!   the run is split at a curve point (or the worst vertex), which becomes a corner too. A
 //!   polyline with no turn or curve point on it has a corner at every vertex. Corners are
 //!   named `c0`, `c1`, … counter-clockwise from the lowest (then leftmost) corner, unless

@@ -11,7 +11,8 @@
 //!   (`Piece Name:`, `Quantity:` 2 for a pair, else 1);
 //! - layer 14: the sewing line (the outline), when the piece has a seam allowance;
 //! - layer 2 turn points at the corners and layer 3 curve points at the middle of each curve,
-//!   for both lines; curves are flattened to chords within 0.05 mm, each notch a vertex;
+//!   for both lines; curves are flattened to chords within 1 µm at even steps of their
+//!   parameter (a notch on a straight edge is a vertex);
 //! - layer 4 notches: a slit LINE from the cut line to the notch on the sewing line (a POINT
 //!   when there is no allowance there), the notch projected onto the outline; layer 7 the
 //!   grain line; layer 6 the mirror line of a piece cut on the fold;

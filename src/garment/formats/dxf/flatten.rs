@@ -1,18 +1,20 @@
 //! The DXF-AAMA writer's plane geometry: an outline flattened into a polyline that keeps its
-//! corners, the middles of its curves and its notches as exact vertices ([`flatten`]), and the
+//! corners, the middles of its curves and its notches on straight edges as exact vertices
+//! ([`flatten`]), and the
 //! polygon offset that draws the cut line around the sewing line ([`offset`]).
 
 use super::geom::{add, closest_on_segment, cross, dist, mul, signed_area, sub};
 use crate::garment::pattern::{Piece, Segment, P2};
 
-/// Largest distance from a flattened curve to its chords (m).
-const FLATTEN_TOL: f64 = 5e-5;
+/// Largest distance from a flattened curve to its chords (m): 1 µm, so that a notch on a
+/// curve, read back on the chords, stays within 0.01 mm.
+const FLATTEN_TOL: f64 = 1e-6;
 /// Samples per curve of the coarse search for the point nearest a notch.
 const COARSE: usize = 256;
 
 /// The outline flattened: points, which are corners, which are the middles of curves, which
 /// edges (from point i to i + 1) lie on the fold, and where each notch is (its projection onto
-/// the outline, a vertex of `pts`).
+/// the outline; a vertex of `pts` on a straight edge).
 pub(crate) struct Flat {
     pub pts: Vec<P2>,
     pub corners: Vec<usize>,
@@ -65,7 +67,7 @@ fn project(piece: &Piece, p: P2) -> (usize, f64) {
     (best.0, best.1)
 }
 
-/// Flattens the outline of `piece` within 0.05 mm, its notches projected onto it.
+/// Flattens the outline of `piece` within 1 µm, its notches projected onto it.
 pub(crate) fn flatten(piece: &Piece) -> Flat {
     let cs = &piece.outline.corners;
     let n_c = cs.len();

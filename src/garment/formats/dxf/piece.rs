@@ -262,6 +262,12 @@ pub(super) fn build(raw: Raw, name: String, xf: &Xf) -> Result<Piece, String> {
                 edge + 1
             };
             if is_turn {
+                // The corner is the turn point: the vertex it snapped to moves onto it (a
+                // writer's samples crowd at a curve's end; chaining may have dropped the
+                // corner's own vertex as a duplicate of its neighbour).
+                if !flags[k].0 {
+                    pts[k] = m;
+                }
                 flags[k].0 = true;
             } else {
                 flags[k].1 = true;
