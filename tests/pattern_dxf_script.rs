@@ -204,7 +204,7 @@ fn aaron_round_trips_through_dxf_from_a_script() {
 fn notches_on_curves_and_lines_round_trip() {
     // The A-shirt (no notches of its own) with a notch on each piece's first curve, at a third
     // of its parameter, and one in the middle of its first straight edge, as a JSON pattern.
-    let mut original = read_garment(&root().join("scripts/patterns/aaron.garment.json")).unwrap();
+    let mut original = read_garment(root().join("scripts/patterns/aaron.garment.json")).unwrap();
     for piece in &mut original.pieces {
         let cs = piece.outline.corners.clone();
         let n = cs.len();

@@ -31,7 +31,7 @@
 //!   named `c0`, `c1`, … counter-clockwise from the lowest (then leftmost) corner, unless
 //!   `Corner: NAME` texts stand at them (within 0.1 mm): then they take those names, and the
 //!   corner of the first label comes first.
-//! - Annotation text beyond AAMA ([`annotation`], what [`super::dxf_write`] writes):
+//! - Annotation text beyond AAMA (`annotation.rs`, what [`super::dxf_write`] writes):
 //!   `Seam: NAME | PIECE: FROM > TO | PIECE: FROM > TO [| aligned]` in the ENTITIES section
 //!   gives the seams (their pieces and corners must exist), `Placement: side=… anchor=…
 //!   level=… x=… dz=…` in a piece's block its placement (x and dz in file units).

@@ -16,7 +16,7 @@
 //! - layer 4 notches: a slit LINE from the cut line to the notch on the sewing line (a POINT
 //!   when there is no allowance there), the notch projected onto the outline; layer 7 the
 //!   grain line; layer 6 the mirror line of a piece cut on the fold;
-//! - layer 15 annotation text ([`super::dxf::annotation`]): each corner's name at the corner
+//! - layer 15 annotation text (`dxf/annotation.rs`): each corner's name at the corner
 //!   (`Corner: c3`) and the piece's placement (`Placement: side=front anchor=c0 …`).
 //!
 //! The seams are annotation text on layer 15 in the ENTITIES section, one per seam
