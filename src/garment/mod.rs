@@ -17,7 +17,10 @@ pub mod validate;
 pub use dress::{dress, DressParameters, DressReport, Dressed};
 pub use error::PatternError;
 pub use formats::dxf::{parse_pattern_dxf, read_pattern_dxf};
-pub use formats::dxf_write::{pattern_to_dxf, write_pattern_dxf};
+pub use formats::dxf_write::{
+    pattern_to_dxf, pattern_to_dxf_with, write_pattern_dxf, write_pattern_dxf_with, DxfOptions,
+    DxfUnits,
+};
 pub use formats::json::{read_pattern_json, write_pattern_json};
 pub use formats::pattern_sheet::write_pattern_sheet;
 pub use formats::svg::{read_pattern_svg, SvgOptions};

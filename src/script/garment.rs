@@ -1,6 +1,6 @@
 //! Script bindings for garments: pattern files (garment tables, JSON, SVG, DXF-AAMA) as a
-//! `Pattern` handle, and `garment::dress`, which meshes, pre-positions and sews a pattern on the
-//! mannequin into a `Simulation`.
+//! `Pattern` handle, written back as DXF-AAMA (`save_dxf`), and `garment::dress`, which
+//! meshes, pre-positions and sews a pattern on the mannequin into a `Simulation`.
 
 use std::path::Path;
 use std::sync::Arc;
@@ -13,6 +13,7 @@ use super::{function, modules::ApiBuilder, register, Fabric, SimHandle};
 use crate::body::Mannequin;
 use crate::cloth::{FabricParameters, MaterialLaw, SimulationParameters};
 use crate::garment::{dress, read_garment, read_pattern_json, read_pattern_svg, DressParameters};
+use crate::garment::{write_pattern_dxf_with, DxfOptions, DxfUnits};
 use crate::garment::{Pattern, PatternError, SvgOptions};
 use crate::kes::lab::measured_fabric;
 
@@ -114,6 +115,32 @@ pub fn register(engine: &mut ApiBuilder) {
         "Writes the pattern sheet (`.png` or `.svg`): the pieces side by side at 400 pixels per metre,\nnames, grain lines, notches, and each seam's two edges in its colour with its number.",
         |p: &mut PatternHandle, path: &str| -> RResult<()> {
             crate::garment::write_pattern_sheet(Path::new(path), &p.0, 400.0).map_err(rt_err)
+        });
+    register!(engine, "save_dxf", ["pattern: Pattern", "path: String", "()"],
+        "Writes the pattern as a DXF-AAMA file (ASCII DXF R12) in millimetres: one block per piece\nwith its cut line (layer 1), sewing line (14), turn and curve points (2, 3), notches (4),\ngrain line (7), and as annotation text (layer 15) its corner names and placement; the\nseams as `Seam:` annotation texts. `garment::pattern` reads it back into the same pattern.",
+        |p: &mut PatternHandle, path: &str| -> RResult<()> {
+            write_pattern_dxf_with(&p.0, Path::new(path), &DxfOptions::default()).map_err(perr)
+        });
+    register!(engine, "save_dxf", ["pattern: Pattern", "path: String", "options: Map", "()"],
+        "As `save_dxf(path)` with options: `units` (\"mm\" default, \"cm\", \"m\" or \"in\"; written as\n`$INSUNITS` and the AAMA `Units:` text).",
+        |p: &mut PatternHandle, path: &str, m: Map| -> RResult<()> {
+            let mut options = DxfOptions::default();
+            for (k, v) in m {
+                match k.as_str() {
+                    "units" => {
+                        let u = v.into_string().map_err(|t| {
+                            rt_err(format!("`units` must be a string, got {t}"))
+                        })?;
+                        options.units = DxfUnits::parse(&u).map_err(perr)?;
+                    }
+                    other => {
+                        return Err(rt_err(format!(
+                            "save_dxf: unknown option `{other}` (expected `units`)"
+                        )))
+                    }
+                }
+            }
+            write_pattern_dxf_with(&p.0, Path::new(path), &options).map_err(perr)
         });
     register!(
         engine,

@@ -22,11 +22,19 @@
 //!   from the sew line to the boundary along the sew line's outward normal, over the parts
 //!   where they differ (a fold or an edge without allowance counts for nothing).
 //! - Layer 2 turn points and 3 curve points (POINTs within 0.1 mm of the outline). The
-//!   corners are the turn points; between two, the polyline becomes a straight line, or one
-//!   cubic Bézier fitted by least squares when one follows every vertex within 0.05 mm; else
+//!   corners are the turn points (the outline's vertex within 0.1 mm of one moves onto it);
+//!   between two, the polyline becomes a straight line, or one cubic Bézier fitted by least
+//!   squares (from chord-length and from even parameters, the better fit kept) when one
+//!   follows every vertex within 0.05 mm; else
 //!   the run is split at a curve point (or the worst vertex), which becomes a corner too. A
 //!   polyline with no turn or curve point on it has a corner at every vertex. Corners are
-//!   named `c0`, `c1`, … counter-clockwise from the lowest (then leftmost) corner.
+//!   named `c0`, `c1`, … counter-clockwise from the lowest (then leftmost) corner, unless
+//!   `Corner: NAME` texts stand at them (within 0.1 mm): then they take those names, and the
+//!   corner of the first label comes first.
+//! - Annotation text beyond AAMA (`annotation.rs`, what [`super::dxf_write`] writes):
+//!   `Seam: NAME | PIECE: FROM > TO | PIECE: FROM > TO [| aligned]` in the ENTITIES section
+//!   gives the seams (their pieces and corners must exist), `Placement: side=… anchor=…
+//!   level=… x=… dz=…` in a piece's block its placement (x and dz in file units).
 //! - Layer 4 and 80–83 notches (POINT, LINE or polyline): the point of the shape nearest the
 //!   outline, projected onto it. Layer 6 mirror line: the straight edge lying on it (within
 //!   0.5 mm; collinear edges on it are merged) is the fold. Layer 7 grain line (LINE or
@@ -46,6 +54,8 @@
 //! line on no straight edge. In binary files the entity types the `dxf` crate does not know
 //! cannot be seen, so they are skipped without a word.
 
+pub(crate) mod annotation;
+pub(crate) mod flatten;
 pub(crate) mod geom;
 mod piece;
 mod scan;
@@ -56,7 +66,7 @@ use ::dxf::entities::{Entity, EntityType};
 use ::dxf::{Drawing, DxfError};
 
 use crate::garment::error::PatternError;
-use crate::garment::pattern::{Pattern, Piece};
+use crate::garment::pattern::{Pattern, Piece, Seam};
 use piece::{build, collect, Xf};
 
 /// Entity types allowed on AAMA layers.
@@ -213,15 +223,50 @@ pub fn parse_pattern_dxf(data: &[u8], path: &Path) -> Result<Pattern, PatternErr
         }
         let raw = collect(&ents, lines.as_deref(), block.as_deref(), xf.tol())
             .map_err(|m| cx.piece(&unique, m))?;
-        let piece = build(raw, unique.clone(), &xf).map_err(|m| cx.piece(&unique, m))?;
+        let mut piece = build(raw, unique.clone(), &xf).map_err(|m| cx.piece(&unique, m))?;
+        if let Some(v) = value_of(&texts(&ents), annotation::PLACEMENT) {
+            let p = annotation::parse_placement(&v, 1.0 / scale);
+            piece.placement = Some(p.map_err(|m| cx.piece(&unique, m))?);
+        }
         pieces.push(piece);
     }
+    let seams = read_seams(&top_texts, &pieces).map_err(|m| cx.parse(0, m))?;
     Ok(Pattern {
         name,
         source: path.display().to_string(),
         pieces,
-        seams: Vec::new(),
+        seams,
     })
+}
+
+/// The seams of the `Seam:` annotation texts, each edge checked against the pieces read.
+fn read_seams(texts: &[String], pieces: &[Piece]) -> Result<Vec<Seam>, String> {
+    let mut seams = Vec::new();
+    for t in texts {
+        let Some((k, v)) = t.split_once(':') else {
+            continue;
+        };
+        if !k.trim().eq_ignore_ascii_case(annotation::SEAM) {
+            continue;
+        }
+        let s = annotation::parse_seam(v.trim())?;
+        for e in [&s.a, &s.b] {
+            let p = pieces
+                .iter()
+                .find(|p| p.name == e.piece)
+                .ok_or_else(|| format!("seam '{}': no piece '{}'", s.name, e.piece))?;
+            for c in [&e.from, &e.to] {
+                if p.outline.corner_index(c).is_none() {
+                    return Err(format!(
+                        "seam '{}': piece '{}' has no corner '{c}'",
+                        s.name, e.piece
+                    ));
+                }
+            }
+        }
+        seams.push(s);
+    }
+    Ok(seams)
 }
 
 /// The first entity of `block` (`None`: the ENTITIES section) of a type not allowed on the

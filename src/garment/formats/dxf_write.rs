@@ -1,43 +1,132 @@
 //! DXF-AAMA export of a [`Pattern`], for CAD systems and for round trips through
 //! [`super::dxf::read_pattern_dxf`].
 //!
-//! The file is ASCII DXF R12 (`AC1009`) in millimetres (`Units: METRIC` style text and
-//! `$INSUNITS` = 4), as pattern CAD systems write it: one BLOCK per piece, placed by an INSERT
-//! at the origin, holding
+//! The file is ASCII DXF R12 (`AC1009`) in millimetres by default (`Units: METRIC` style text
+//! and `$INSUNITS` = 4), as pattern CAD systems write it; [`DxfOptions::units`] picks
+//! centimetres (`Units: CM`, 5), metres (`Units: M`, 6) or inches (`Units: ENGLISH`, 1)
+//! instead (AAMA itself knows only METRIC and ENGLISH). One BLOCK per piece, placed by an
+//! INSERT at the origin, holds
 //! - layer 1: the boundary (cut line) as a closed POLYLINE: the sewing line offset by the seam
 //!   allowance (mitred corners; no allowance along a fold), and the piece system text
 //!   (`Piece Name:`, `Quantity:` 2 for a pair, else 1);
 //! - layer 14: the sewing line (the outline), when the piece has a seam allowance;
 //! - layer 2 turn points at the corners and layer 3 curve points at the middle of each curve,
-//!   for both lines; curves are flattened to chords within 0.05 mm;
+//!   for both lines; curves are flattened to chords within 1 µm at even steps of their
+//!   parameter (a notch on a straight edge is a vertex);
 //! - layer 4 notches: a slit LINE from the cut line to the notch on the sewing line (a POINT
-//!   when there is no allowance there); layer 7 the grain line; layer 6 the mirror line of a
-//!   piece cut on the fold.
+//!   when there is no allowance there), the notch projected onto the outline; layer 7 the
+//!   grain line; layer 6 the mirror line of a piece cut on the fold;
+//! - layer 15 annotation text (`dxf/annotation.rs`): each corner's name at the corner
+//!   (`Corner: c3`) and the piece's placement (`Placement: side=front anchor=c0 …`).
 //!
-//! Seams and placements have no AAMA form and are not written.
+//! The seams are annotation text on layer 15 in the ENTITIES section, one per seam
+//! (`Seam: side | front: c2 > c3 | back: c3' > c2'`).
 
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::dxf::geom::{add, bezier, closest_on_loop, cross, dist, mul, signed_area, sub};
+use super::dxf::annotation;
+use super::dxf::flatten::{flatten, offset};
+use super::dxf::geom::{add, closest_on_loop, mul, signed_area, sub};
 use crate::garment::error::PatternError;
 use crate::garment::pattern::{Copies, Pattern, Piece, Segment, P2};
 
-/// Largest distance from a flattened curve to its chords (m).
-const FLATTEN_TOL: f64 = 5e-5;
-
-/// Writes `pattern` as a DXF-AAMA file.
-pub fn write_pattern_dxf(pattern: &Pattern, path: &Path) -> Result<(), PatternError> {
-    let text = pattern_to_dxf(pattern)?;
-    std::fs::write(path, text).map_err(|source| PatternError::Io {
-        path: path.to_path_buf(),
-        source,
-    })
+/// The length unit of a written DXF-AAMA file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DxfUnits {
+    /// Millimetres (`Units: METRIC`, `$INSUNITS` 4): what AAMA CAD systems expect.
+    #[default]
+    Millimetres,
+    /// Centimetres (`Units: CM`, `$INSUNITS` 5).
+    Centimetres,
+    /// Metres (`Units: M`, `$INSUNITS` 6).
+    Metres,
+    /// Inches (`Units: ENGLISH`, `$INSUNITS` 1).
+    Inches,
 }
 
-/// The text of the DXF-AAMA file for `pattern`.
+impl DxfUnits {
+    /// The unit named `mm`, `cm`, `m` or `in`.
+    pub fn parse(name: &str) -> Result<DxfUnits, PatternError> {
+        match name {
+            "mm" => Ok(DxfUnits::Millimetres),
+            "cm" => Ok(DxfUnits::Centimetres),
+            "m" => Ok(DxfUnits::Metres),
+            "in" => Ok(DxfUnits::Inches),
+            _ => Err(PatternError::Parameter(format!(
+                "DXF units '{name}': expected \"mm\", \"cm\", \"m\" or \"in\""
+            ))),
+        }
+    }
+    /// File units per metre.
+    pub fn per_metre(self) -> f64 {
+        match self {
+            DxfUnits::Millimetres => 1000.0,
+            DxfUnits::Centimetres => 100.0,
+            DxfUnits::Metres => 1.0,
+            DxfUnits::Inches => 1.0 / 0.0254,
+        }
+    }
+    fn insunits(self) -> i32 {
+        match self {
+            DxfUnits::Millimetres => 4,
+            DxfUnits::Centimetres => 5,
+            DxfUnits::Metres => 6,
+            DxfUnits::Inches => 1,
+        }
+    }
+    fn style_text(self) -> &'static str {
+        match self {
+            DxfUnits::Millimetres => "METRIC",
+            DxfUnits::Centimetres => "CM",
+            DxfUnits::Metres => "M",
+            DxfUnits::Inches => "ENGLISH",
+        }
+    }
+}
+
+/// How a pattern is written to DXF-AAMA.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct DxfOptions {
+    /// The file's length unit.
+    pub units: DxfUnits,
+}
+
+/// Writes `pattern` as a DXF-AAMA file in millimetres.
+pub fn write_pattern_dxf(pattern: &Pattern, path: &Path) -> Result<(), PatternError> {
+    write_pattern_dxf_with(pattern, path, &DxfOptions::default())
+}
+
+/// Writes `pattern` as a DXF-AAMA file with `options`, creating the file's folder if needed.
+pub fn write_pattern_dxf_with(
+    pattern: &Pattern,
+    path: &Path,
+    options: &DxfOptions,
+) -> Result<(), PatternError> {
+    let text = pattern_to_dxf_with(pattern, options)?;
+    let io = |source| PatternError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(io)?;
+    }
+    std::fs::write(path, text).map_err(io)
+}
+
+/// The text of the DXF-AAMA file for `pattern`, in millimetres.
 pub fn pattern_to_dxf(pattern: &Pattern) -> Result<String, PatternError> {
-    let mut blocks = Out::default();
+    pattern_to_dxf_with(pattern, &DxfOptions::default())
+}
+
+/// The text of the DXF-AAMA file for `pattern` with `options`.
+pub fn pattern_to_dxf_with(
+    pattern: &Pattern,
+    options: &DxfOptions,
+) -> Result<String, PatternError> {
+    let per_m = options.units.per_metre();
+    let seam_texts = seam_texts(pattern)?;
+    let mut blocks = Out::new(per_m);
     let mut names: Vec<String> = Vec::new();
     for piece in &pattern.pieces {
         let base: String = piece
@@ -70,14 +159,14 @@ pub fn pattern_to_dxf(pattern: &Pattern) -> Result<String, PatternError> {
         names.push(name);
     }
 
-    let mut o = Out::default();
+    let mut o = Out::new(per_m);
     o.section("HEADER");
     o.pair(9, "$ACADVER");
     o.pair(1, "AC1009");
     o.pair(9, "$INSUNITS");
-    o.pair(70, 4);
+    o.pair(70, options.units.insunits());
     o.pair(9, "$MEASUREMENT");
-    o.pair(70, 1);
+    o.pair(70, i32::from(options.units != DxfUnits::Inches));
     o.pair(0, "ENDSEC");
     o.section("TABLES");
     o.table("LTYPE", 1);
@@ -89,7 +178,7 @@ pub fn pattern_to_dxf(pattern: &Pattern) -> Result<String, PatternError> {
     o.pair(73, 0);
     o.pair(40, "0.0");
     o.pair(0, "ENDTAB");
-    let layers = ["1", "2", "3", "4", "6", "7", "14"];
+    let layers = ["1", "2", "3", "4", "6", "7", "14", "15"];
     o.table("LAYER", layers.len());
     for l in layers {
         o.pair(0, "LAYER");
@@ -101,15 +190,19 @@ pub fn pattern_to_dxf(pattern: &Pattern) -> Result<String, PatternError> {
     o.pair(0, "ENDTAB");
     o.pair(0, "ENDSEC");
     o.section("BLOCKS");
-    o.0.push_str(&blocks.0);
+    o.s.push_str(&blocks.s);
     o.pair(0, "ENDSEC");
     o.section("ENTITIES");
     let style = one_line(&pattern.name);
-    for (i, t) in [format!("Style Name: {style}"), "Units: METRIC".into()]
-        .iter()
-        .enumerate()
-    {
-        o.text(t, [0.0, -0.01 * (i as f64 + 1.0)], 5.0);
+    let style_texts = [
+        format!("Style Name: {style}"),
+        format!("Units: {}", options.units.style_text()),
+    ];
+    for (i, t) in style_texts.iter().enumerate() {
+        o.text("1", t, [0.0, -0.01 * (i as f64 + 1.0)], 5.0);
+    }
+    for (i, t) in seam_texts.iter().enumerate() {
+        o.text("15", t, [0.0, -0.01 * (i as f64 + 3.0)], 5.0);
     }
     for n in &names {
         o.pair(0, "INSERT");
@@ -119,29 +212,65 @@ pub fn pattern_to_dxf(pattern: &Pattern) -> Result<String, PatternError> {
     }
     o.pair(0, "ENDSEC");
     o.pair(0, "EOF");
-    Ok(o.0)
+    Ok(o.s)
+}
+
+/// The seams as annotation texts, each checked against the pieces and corners it names.
+fn seam_texts(pattern: &Pattern) -> Result<Vec<String>, PatternError> {
+    let err = |message: String| PatternError::Parse {
+        path: pattern.source.clone().into(),
+        line: 0,
+        message,
+    };
+    let mut out = Vec::new();
+    for s in &pattern.seams {
+        for e in [&s.a, &s.b] {
+            let p = pattern
+                .pieces
+                .iter()
+                .find(|p| p.name == e.piece)
+                .ok_or_else(|| err(format!("seam '{}': no piece '{}'", s.name, e.piece)))?;
+            for c in [&e.from, &e.to] {
+                if p.outline.corner_index(c).is_none() {
+                    let m = format!("seam '{}': piece '{}' has no corner '{c}'", s.name, e.piece);
+                    return Err(err(m));
+                }
+            }
+        }
+        out.push(annotation::seam_text(s).map_err(err)?);
+    }
+    Ok(out)
 }
 
 fn one_line(s: &str) -> String {
     s.replace(['\r', '\n'], " ")
 }
 
-/// Group codes and values, one per line, coordinates in mm.
-#[derive(Default)]
-struct Out(String);
+/// Group codes and values, one per line; points given in metres are written in file units.
+struct Out {
+    s: String,
+    /// File units per metre.
+    per_m: f64,
+}
 
 impl Out {
+    fn new(per_m: f64) -> Out {
+        Out {
+            s: String::new(),
+            per_m,
+        }
+    }
     fn pair(&mut self, code: i32, value: impl std::fmt::Display) {
-        let _ = writeln!(self.0, "{code:>3}\n{value}");
+        let _ = writeln!(self.s, "{code:>3}\n{value}");
     }
     fn num(&mut self, code: i32, v: f64) {
         let v = if v.abs() < 5e-7 { 0.0 } else { v };
         self.pair(code, format!("{v:.6}"));
     }
-    /// A point given in metres, written in mm under `code`, `code + 10`, `code + 20`.
+    /// A point given in metres, under `code`, `code + 10`, `code + 20`.
     fn point(&mut self, code: i32, p: P2) {
-        self.num(code, p[0] * 1000.0);
-        self.num(code + 10, p[1] * 1000.0);
+        self.num(code, p[0] * self.per_m);
+        self.num(code + 10, p[1] * self.per_m);
         self.num(code + 20, 0.0);
     }
     fn section(&mut self, name: &str) {
@@ -178,98 +307,14 @@ impl Out {
         self.point(10, a);
         self.point(11, b);
     }
-    /// A TEXT on layer 1 at `at` (m), `height` mm high.
-    fn text(&mut self, value: &str, at: P2, height: f64) {
+    /// A TEXT on `layer` at `at` (m), `height_mm` millimetres high.
+    fn text(&mut self, layer: &str, value: &str, at: P2, height_mm: f64) {
         self.pair(0, "TEXT");
-        self.pair(8, "1");
+        self.pair(8, layer);
         self.point(10, at);
-        self.num(40, height);
+        self.num(40, height_mm * 1e-3 * self.per_m);
         self.pair(1, one_line(value));
     }
-}
-
-/// The outline flattened: points, which are corners, which are the middles of curves, and
-/// which edges (from point i to i + 1) lie on the fold.
-struct Flat {
-    pts: Vec<P2>,
-    corners: Vec<usize>,
-    middles: Vec<usize>,
-    fold: Vec<bool>,
-}
-
-fn flatten(piece: &Piece) -> Flat {
-    let cs = &piece.outline.corners;
-    let mut f = Flat {
-        pts: Vec::new(),
-        corners: Vec::new(),
-        middles: Vec::new(),
-        fold: Vec::new(),
-    };
-    for (i, c) in cs.iter().enumerate() {
-        let (p0, p3) = (c.at, cs[(i + 1) % cs.len()].at);
-        let on_fold = piece.fold.as_deref() == Some(c.name.as_str());
-        f.corners.push(f.pts.len());
-        match c.segment {
-            Segment::Line => {
-                f.pts.push(p0);
-                f.fold.push(on_fold);
-            }
-            Segment::Cubic { c1, c2 } => {
-                // Chord error of n even steps ≤ max|B''| / (8 n²), |B''| ≤ 6 max(|Δ²P|).
-                let d2 = dist(add(p0, c2), mul(c1, 2.0)).max(dist(add(c1, p3), mul(c2, 2.0)));
-                let n = ((6.0 * d2 / (8.0 * FLATTEN_TOL)).sqrt().ceil() as usize).clamp(2, 2000);
-                let n = n + n % 2;
-                for k in 0..n {
-                    if k == n / 2 {
-                        f.middles.push(f.pts.len());
-                    }
-                    let p = bezier([p0, c1, c2, p3], k as f64 / n as f64);
-                    f.pts.push(p);
-                    f.fold.push(on_fold);
-                }
-            }
-        }
-    }
-    f
-}
-
-/// The polygon `pts` with each edge moved outwards by its own distance `d[i]` (mitred, the
-/// mitre limited to four times the largest distance). Vertex i of the result goes with
-/// vertex i of `pts`.
-fn offset(pts: &[P2], d: &[f64]) -> Vec<P2> {
-    let n = pts.len();
-    let sign = signed_area(pts).signum();
-    let normal = |i: usize| {
-        let e = sub(pts[(i + 1) % n], pts[i]);
-        let l = e[0].hypot(e[1]).max(1e-300);
-        mul([e[1], -e[0]], sign / l)
-    };
-    let limit = 4.0 * d.iter().cloned().fold(0.0, f64::max);
-    (0..n)
-        .map(|i| {
-            let j = (i + n - 1) % n;
-            let (n0, n1) = (normal(j), normal(i));
-            let det = cross(n0, n1);
-            let p = if det.abs() < 1e-9 {
-                add(pts[i], mul(n1, d[i]))
-            } else {
-                // The offset q = p − v with n0·q = d0 and n1·q = d1.
-                let (r0, r1) = (d[j], d[i]);
-                let q = [
-                    (r0 * n1[1] - r1 * n0[1]) / det,
-                    (n0[0] * r1 - n1[0] * r0) / det,
-                ];
-                add(pts[i], q)
-            };
-            let off = sub(p, pts[i]);
-            let l = off[0].hypot(off[1]);
-            if l > limit && l > 0.0 {
-                add(pts[i], mul(off, limit / l))
-            } else {
-                p
-            }
-        })
-        .collect()
 }
 
 fn write_block(o: &mut Out, piece: &Piece, name: &str) -> Result<(), String> {
@@ -291,6 +336,14 @@ fn write_block(o: &mut Out, piece: &Piece, name: &str) -> Result<(), String> {
     {
         return Err("coordinates or seam allowance are not finite numbers".into());
     }
+    for c in cs {
+        annotation::check_name(&c.name, "corner")?;
+    }
+    let placement = piece
+        .placement
+        .as_ref()
+        .map(|p| annotation::placement_text(p, o.per_m))
+        .transpose()?;
     let flat = flatten(piece);
     if flat.pts.len() < 3 || signed_area(&flat.pts) == 0.0 {
         return Err("the outline encloses no area".into());
@@ -330,11 +383,11 @@ fn write_block(o: &mut Out, piece: &Piece, name: &str) -> Result<(), String> {
             .iter()
             .for_each(|&i| o.point_entity("3", pts[i]));
     }
-    for &p in &piece.notches {
-        let (q, _, e, _) = closest_on_loop(&flat.pts, p);
+    let sign = signed_area(&flat.pts).signum();
+    for &q in &flat.notches {
+        let (_, _, e, _) = closest_on_loop(&flat.pts, q);
         let edge = sub(flat.pts[(e + 1) % flat.pts.len()], flat.pts[e]);
         let l = edge[0].hypot(edge[1]);
-        let sign = signed_area(&flat.pts).signum();
         if d[e] > 0.0 && l > 0.0 {
             let out = mul([edge[1], -edge[0]], sign * d[e] / l);
             o.line("4", add(q, out), q);
@@ -346,6 +399,10 @@ fn write_block(o: &mut Out, piece: &Piece, name: &str) -> Result<(), String> {
     if let Some(i) = cs.iter().position(|c| Some(&c.name) == piece.fold.as_ref()) {
         o.line("6", cs[i].at, cs[(i + 1) % cs.len()].at);
     }
+    // Corner names at the corners, in outline order (the first label is the first corner).
+    for c in cs {
+        o.text("15", &annotation::corner_text(&c.name), c.at, 2.0);
+    }
     // Piece system text near the middle of the piece, 5 mm high.
     let n = flat.pts.len() as f64;
     let centre = mul(flat.pts.iter().fold([0.0; 2], |a, &p| add(a, p)), 1.0 / n);
@@ -355,7 +412,10 @@ fn write_block(o: &mut Out, piece: &Piece, name: &str) -> Result<(), String> {
         format!("Quantity: {quantity}"),
     ];
     for (i, t) in texts.iter().enumerate() {
-        o.text(t, [centre[0], centre[1] - 0.008 * i as f64], 5.0);
+        o.text("1", t, [centre[0], centre[1] - 0.008 * i as f64], 5.0);
+    }
+    if let Some(t) = placement {
+        o.text("15", &t, [centre[0], centre[1] - 0.016], 5.0);
     }
     o.pair(0, "ENDBLK");
     o.pair(8, "1");

@@ -243,10 +243,11 @@ fn bezier_d2(p: [P2; 4], t: f64) -> P2 {
 }
 
 /// Least-squares cubic through `q` (ends fixed, inner control points free), with Newton
-/// reparameterisation. Returns the control points and the largest point error.
+/// reparameterisation from chord-length parameters, and again from evenly spaced ones (how
+/// writers sample a curve, ours included); the better of the two. Returns the control points
+/// and the largest point error.
 fn fit_cubic(q: &[P2]) -> Option<([P2; 4], f64)> {
     let m = q.len() - 1;
-    let (p0, p3) = (q[0], q[m]);
     let mut u = vec![0.0; q.len()];
     for i in 1..=m {
         u[i] = u[i - 1] + dist(q[i], q[i - 1]);
@@ -256,6 +257,17 @@ fn fit_cubic(q: &[P2]) -> Option<([P2; 4], f64)> {
         return None;
     }
     u.iter_mut().for_each(|x| *x /= total);
+    let even: Vec<f64> = (0..=m).map(|i| i as f64 / m as f64).collect();
+    match (fit_cubic_from(q, u, total), fit_cubic_from(q, even, total)) {
+        (Some(a), Some(b)) => Some(if b.1 < a.1 { b } else { a }),
+        (a, b) => a.or(b),
+    }
+}
+
+/// [`fit_cubic`] from the starting parameters `u` (0 to 1); `total` is the polyline's length.
+fn fit_cubic_from(q: &[P2], mut u: Vec<f64>, total: f64) -> Option<([P2; 4], f64)> {
+    let m = q.len() - 1;
+    let (p0, p3) = (q[0], q[m]);
     let mut ctrl = [p0, p0, p3, p3];
     for _ in 0..400 {
         let (mut a11, mut a12, mut a22) = (0.0, 0.0, 0.0);

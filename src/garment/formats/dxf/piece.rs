@@ -4,6 +4,7 @@
 
 use ::dxf::entities::{Entity, EntityType};
 
+use super::annotation;
 use super::geom::{self, add, closest_on_loop, dist, mul, signed_area, Path as GPath};
 use super::{layer_of, locate, role, texts, value_of};
 use crate::garment::pattern::{Copies, Corner, Outline, Piece, Segment, P2};
@@ -81,6 +82,8 @@ pub(super) struct Raw {
     mirror: Vec<(Vec<P2>, String)>,
     grain: Vec<(Vec<P2>, String)>,
     quantity: Option<u32>,
+    /// Corner labels (`Corner: NAME` texts) where they stand, in file order.
+    labels: Vec<(P2, String)>,
 }
 
 /// Sorts the entities of one piece by layer. `tol` (block units) bounds arc flattening.
@@ -98,6 +101,11 @@ pub(super) fn collect(
         ..Raw::default()
     };
     for (k, e) in ents.iter().enumerate() {
+        if let EntityType::Text(t) = &e.specific {
+            if let Some(name) = value_of(std::slice::from_ref(&t.value), annotation::CORNER) {
+                raw.labels.push(([t.location.x, t.location.y], name));
+            }
+        }
         let Some(layer) = layer_of(e) else { continue };
         let at = locate(ents, k, lines, block);
         let xy = |p: &::dxf::Point| [p.x, p.y];
@@ -254,6 +262,12 @@ pub(super) fn build(raw: Raw, name: String, xf: &Xf) -> Result<Piece, String> {
                 edge + 1
             };
             if is_turn {
+                // The corner is the turn point: the vertex it snapped to moves onto it (a
+                // writer's samples crowd at a curve's end; chaining may have dropped the
+                // corner's own vertex as a duplicate of its neighbour).
+                if !flags[k].0 {
+                    pts[k] = m;
+                }
                 flags[k].0 = true;
             } else {
                 flags[k].1 = true;
@@ -303,21 +317,42 @@ pub(super) fn build(raw: Raw, name: String, xf: &Xf) -> Result<Piece, String> {
         fold = Some(fold_at);
     }
 
-    // Name from the lowest-leftmost corner, counter-clockwise.
+    // Corner names from the labels at the corners, the first label's corner first; else
+    // `c0`, `c1`, … from the lowest-leftmost corner, counter-clockwise.
     let at: Vec<P2> = corners.iter().map(|c| c.0).collect();
-    let first = geom::lowest_leftmost(&at);
+    let labels: Vec<(P2, &str)> = raw
+        .labels
+        .iter()
+        .map(|(p, n)| (xf.apply(*p), n.as_str()))
+        .collect();
+    let label_of = |p: P2| {
+        labels
+            .iter()
+            .find(|(q, _)| dist(*q, p) <= MARK_TOL)
+            .map(|(_, n)| *n)
+    };
+    let first = labels
+        .first()
+        .and_then(|(q, _)| at.iter().position(|&p| dist(*q, p) <= MARK_TOL))
+        .unwrap_or_else(|| geom::lowest_leftmost(&at));
     corners.rotate_left(first);
     let n = corners.len();
-    let fold = fold.map(|f| format!("c{}", (f + n - first) % n));
+    let mut names: Vec<String> = Vec::with_capacity(n);
+    for (i, c) in corners.iter().enumerate() {
+        let mut name = label_of(c.0).map_or_else(|| format!("c{i}"), str::to_string);
+        while names.contains(&name)
+            || (label_of(c.0).is_none() && labels.iter().any(|l| l.1 == name))
+        {
+            name.push('+');
+        }
+        names.push(name);
+    }
+    let fold = fold.map(|f| names[(f + n - first) % n].clone());
     let outline = Outline {
         corners: corners
             .iter()
-            .enumerate()
-            .map(|(i, &(at, segment))| Corner {
-                name: format!("c{i}"),
-                at,
-                segment,
-            })
+            .zip(names)
+            .map(|(&(at, segment), name)| Corner { name, at, segment })
             .collect(),
     };
 
