@@ -18,7 +18,7 @@ pub mod topology;
 
 pub use camera::{Camera, LookAtCamera};
 pub use error::GeometryError;
-pub use files::photo_files;
+pub use image::photo_files;
 pub use gltf::write_glb;
 pub use grid::grid_mesh;
 pub use mesh::TriMesh;
