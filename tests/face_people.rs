@@ -51,7 +51,8 @@ fn person(g: &FaceMesh, width: f64, length: f64, nose: f64, eyes: f64) -> FaceMe
         d.x += (width - 1.0) * o.x;
         d.y -= (length - 1.0) * (nose_base_y - o.y).max(0.0);
         d.z += nose * gauss((o - tip).norm_squared(), 0.012);
-        d.x += eyes * (gauss((o - left).norm_squared(), 0.012) - gauss((o - right).norm_squared(), 0.012));
+        d.x += eyes
+            * (gauss((o - left).norm_squared(), 0.012) - gauss((o - right).norm_squared(), 0.012));
         *q = o + d;
     }
     out
@@ -161,8 +162,15 @@ fn four_peoples_photos_give_four_people_each_fitted_as_well_as_alone() {
     // each person alone: a folder of one person's views is one person
     let mut alone_err = Vec::new();
     for (name, _) in PEOPLE {
-        let fits = fit_people(&alone.join(name), None, &root.join("out_alone").join(name), Grouping::default(), &opts, 128)
-            .unwrap();
+        let fits = fit_people(
+            &alone.join(name),
+            None,
+            &root.join("out_alone").join(name),
+            Grouping::default(),
+            &opts,
+            128,
+        )
+        .unwrap();
         assert_eq!(fits.len(), 1, "{name}");
         assert_eq!(fits[0].name, name);
         assert_eq!(fits[0].report.names, ["front", "left", "right"]);
@@ -179,22 +187,35 @@ fn four_peoples_photos_give_four_people_each_fitted_as_well_as_alone() {
     assert!(ok, "{stdout}\n{stderr}");
     println!("{stdout}");
     assert!(stdout.lines().any(|l| l == "people=4"), "{stdout}");
-    assert!(stdout.lines().last().unwrap().ends_with(" images=12"), "{stdout}");
+    assert!(
+        stdout.lines().last().unwrap().ends_with(" images=12"),
+        "{stdout}"
+    );
     let people_csv = std::fs::read_to_string(out.join("people.csv")).unwrap();
-    let rows: Vec<Vec<&str>> = people_csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    let rows: Vec<Vec<&str>> = people_csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
     assert_eq!(rows.len(), 4, "{people_csv}");
     for (row, ((name, _), alone)) in rows.iter().zip(PEOPLE.iter().zip(&alone_err)) {
         assert_eq!(row[0], *name, "{people_csv}");
         assert_eq!(row[1], "3", "{people_csv}");
         let err: f64 = row[2].parse().unwrap();
         println!("{name}: {err:.3} % of the IOD in the mixed folder, {alone:.3} % alone");
-        assert!(err <= 1.0 && (err - alone).abs() <= 0.05 * alone.max(0.1), "{name}: {err} vs {alone}");
+        assert!(
+            err <= 1.0 && (err - alone).abs() <= 0.05 * alone.max(0.1),
+            "{name}: {err} vs {alone}"
+        );
         assert!(out.join(name).join("face.obj").is_file(), "{name}");
         assert!(out.join(name).join("fit.csv").is_file(), "{name}");
     }
     let photos_csv = std::fs::read_to_string(out.join("photos.csv")).unwrap();
     assert_eq!(photos_csv.lines().count(), 13, "{photos_csv}");
-    assert!(photos_csv.contains("\nbob,bob_left,") && photos_csv.contains("\ncarol,front,"), "{photos_csv}");
+    assert!(
+        photos_csv.contains("\nbob,bob_left,") && photos_csv.contains("\ncarol,front,"),
+        "{photos_csv}"
+    );
 
     // all twelve photos as one face (the old rule) mixes the people: clearly worse
     let flat = root.join("flat");
@@ -204,16 +225,30 @@ fn four_peoples_photos_give_four_people_each_fitted_as_well_as_alone() {
         let name = person.file_name().unwrap().to_str().unwrap().to_string();
         for f in std::fs::read_dir(&person).unwrap() {
             let f = f.unwrap().path();
-            let to = flat.join(format!("{name}-{}", f.file_name().unwrap().to_str().unwrap()));
+            let to = flat.join(format!(
+                "{name}-{}",
+                f.file_name().unwrap().to_str().unwrap()
+            ));
             std::fs::copy(&f, to).unwrap();
         }
     }
-    let one = fit_people(&flat, None, &root.join("out_flat"), Grouping::Folder, &opts, 128).unwrap();
+    let one = fit_people(
+        &flat,
+        None,
+        &root.join("out_flat"),
+        Grouping::Folder,
+        &opts,
+        128,
+    )
+    .unwrap();
     assert_eq!(one.len(), 1);
     let mixed_err = one[0].report.mean_error_iod_pct();
     let worst_alone = alone_err.iter().copied().fold(0.0, f64::max);
     println!("all 12 photos as one face: {mixed_err:.3} % of the IOD (worst person alone {worst_alone:.3} %)");
-    assert!(mixed_err > 2.0 * worst_alone, "{mixed_err} vs {worst_alone}");
+    assert!(
+        mixed_err > 2.0 * worst_alone,
+        "{mixed_err} vs {worst_alone}"
+    );
 }
 
 #[test]
@@ -225,7 +260,10 @@ fn photos_group_by_subfolder_name_or_photo() {
     let root = temp("groups");
     let (mixed, _) = make_folders(&root, &g);
     let names = |people: &[emilion::face::people::PersonPhotos]| -> Vec<String> {
-        people.iter().map(|p| format!("{}:{}", p.name, p.photos.len())).collect()
+        people
+            .iter()
+            .map(|p| format!("{}:{}", p.name, p.photos.len()))
+            .collect()
     };
     let by_name = group_people(&mixed, None, Grouping::Names).unwrap();
     assert_eq!(names(&by_name), ["alice:3", "bob:3", "carol:3", "dave:3"]);
@@ -252,5 +290,8 @@ fn photos_group_by_subfolder_name_or_photo() {
         format!("out={}", out.display()),
         "group=people".into(),
     ]);
-    assert!(!ok && stderr.contains("group") && stderr.contains("people"), "{stderr}");
+    assert!(
+        !ok && stderr.contains("group") && stderr.contains("people"),
+        "{stderr}"
+    );
 }

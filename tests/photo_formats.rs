@@ -162,11 +162,7 @@ fn files() -> Vec<(&'static str, Vec<u8>, bool)> {
 fn check_pixels(img: &image::RgbImage, is_grey: bool, what: &str) {
     assert_eq!(img.dimensions(), (W, H), "{what}");
     for (x, y, p) in img.enumerate_pixels() {
-        let want = if is_grey {
-            [grey(x, y); 3]
-        } else {
-            rgb(x, y)
-        };
+        let want = if is_grey { [grey(x, y); 3] } else { rgb(x, y) };
         assert_eq!(p.0, want, "{what}: pixel ({x}, {y})");
     }
 }

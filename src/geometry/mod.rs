@@ -18,9 +18,9 @@ pub mod topology;
 
 pub use camera::{Camera, LookAtCamera};
 pub use error::GeometryError;
-pub use image::photo_files;
 pub use gltf::write_glb;
 pub use grid::grid_mesh;
+pub use image::photo_files;
 pub use mesh::TriMesh;
 pub use obj::{read_obj, read_obj_surface, write_obj};
 pub use random::{Lcg64, SplitMix64};
