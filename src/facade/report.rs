@@ -79,6 +79,20 @@ pub fn labelled_images(dir: &Path) -> Result<Vec<String>, FacadeError> {
     Ok(stems)
 }
 
+/// The photo `dir/images/STEM.EXT` of a labelled facade, in whichever photo format it is
+/// ([`photo_with_stem`](crate::geometry::image::photo_with_stem)); an error names the folder
+/// and the stem when there is none.
+pub fn labelled_photo(dir: &Path, stem: &str) -> Result<PathBuf, FacadeError> {
+    let images = dir.join("images");
+    crate::geometry::image::photo_with_stem(&images, stem).ok_or_else(|| FacadeError::File {
+        path: images.join(stem),
+        message: format!(
+            "no photo of this stem ({})",
+            crate::geometry::image::photo_formats::photo_extensions_list()
+        ),
+    })
+}
+
 /// Means and pooled figures of `reports`.
 pub fn summarize(reports: &[ImageReport]) -> Summary {
     let k = reports.len().max(1) as f64;

@@ -18,8 +18,8 @@ use crate::geometry::GeometryError;
 /// name. Each is decoded by the `image` crate (its `png`, `jpeg`, `pnm`, `tiff`, `bmp`, `webp`
 /// and `tga` features).
 pub const PHOTO_EXTENSIONS: &[&str] = &[
-    "png", "jpg", "jpeg", "jpe", "jfif", "ppm", "pgm", "pbm", "pnm", "pam", "tif", "tiff", "bmp",
-    "webp", "tga",
+    "png", "jpg", "jpeg", "jfif", "ppm", "pgm", "pbm", "pnm", "pam", "tif", "tiff", "bmp", "webp",
+    "tga",
 ];
 
 /// The readable extensions as a short list for messages: `png, jpg, jpeg, …`.
