@@ -429,3 +429,33 @@ fn script_makes_a_sequence() {
     assert!(seq.frame_images(1).is_ok());
     let _ = std::fs::remove_dir_all(&out);
 }
+
+#[test]
+fn frames_in_other_photo_formats_are_read() {
+    let dir = scratch("formats");
+    copy_dir(base(), &dir);
+    let want = Sequence::open(base()).unwrap().frame_images(1).unwrap();
+    // camera 0's frame 1 as a hand-written PPM, camera 2's as a BMP (both lossless)
+    let png = dir.join("images/cam0/0001.png");
+    let img = image::open(&png).unwrap().into_rgb8();
+    let mut ppm = format!("P6\n{} {}\n255\n", img.width(), img.height()).into_bytes();
+    ppm.extend_from_slice(img.as_raw());
+    std::fs::write(dir.join("images/cam0/0001.ppm"), ppm).unwrap();
+    std::fs::remove_file(&png).unwrap();
+    let png = dir.join("images/cam2/0001.png");
+    image::open(&png)
+        .unwrap()
+        .save(dir.join("images/cam2/0001.BMP"))
+        .unwrap();
+    std::fs::remove_file(&png).unwrap();
+    let seq = Sequence::open(&dir).unwrap();
+    assert!(seq.image_path(0, 1).ends_with("0001.ppm"));
+    assert_eq!(seq.frame_images(1).unwrap(), want);
+    // an undecodable frame is named
+    std::fs::write(dir.join("images/cam0/0001.ppm"), b"P6 broken").unwrap();
+    let err = seq.frame_images(1).unwrap_err().to_string();
+    assert!(
+        err.contains("0001.ppm") && err.contains("cannot be decoded as an image"),
+        "{err}"
+    );
+}

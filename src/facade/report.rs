@@ -54,7 +54,9 @@ pub struct Summary {
     pub pooled: DetectionScore,
 }
 
-/// Stems of the photos in `dir/images` that have a label map `dir/labels/STEM.png`, sorted.
+/// Stems of the photos (any of the
+/// [`PHOTO_EXTENSIONS`](crate::geometry::image::PHOTO_EXTENSIONS)) in `dir/images` that have
+/// a label map `dir/labels/STEM.png`, sorted.
 pub fn labelled_images(dir: &Path) -> Result<Vec<String>, FacadeError> {
     let images = dir.join("images");
     let err = |e: std::io::Error| FacadeError::File {
@@ -64,6 +66,9 @@ pub fn labelled_images(dir: &Path) -> Result<Vec<String>, FacadeError> {
     let mut stems = Vec::new();
     for entry in std::fs::read_dir(&images).map_err(err)? {
         let p = entry.map_err(err)?.path();
+        if !crate::geometry::image::is_photo(&p) {
+            continue;
+        }
         if let Some(stem) = p.file_stem().and_then(|s| s.to_str()) {
             if dir.join("labels").join(format!("{stem}.png")).is_file() {
                 stems.push(stem.to_string());
@@ -72,6 +77,20 @@ pub fn labelled_images(dir: &Path) -> Result<Vec<String>, FacadeError> {
     }
     stems.sort();
     Ok(stems)
+}
+
+/// The photo `dir/images/STEM.EXT` of a labelled facade, in whichever photo format it is
+/// ([`photo_with_stem`](crate::geometry::image::photo_with_stem)); an error names the folder
+/// and the stem when there is none.
+pub fn labelled_photo(dir: &Path, stem: &str) -> Result<PathBuf, FacadeError> {
+    let images = dir.join("images");
+    crate::geometry::image::photo_with_stem(&images, stem).ok_or_else(|| FacadeError::File {
+        path: images.join(stem),
+        message: format!(
+            "no photo of this stem ({})",
+            crate::geometry::image::photo_formats::photo_extensions_list()
+        ),
+    })
 }
 
 /// Means and pooled figures of `reports`.

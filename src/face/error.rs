@@ -44,6 +44,19 @@ pub enum FaceError {
     Failed(String),
 }
 
+impl From<crate::geometry::GeometryError> for FaceError {
+    /// A geometry error (an unreadable photo, a malformed mesh file) as the face module's
+    /// file error, naming the same file.
+    fn from(e: crate::geometry::GeometryError) -> Self {
+        use crate::geometry::GeometryError as G;
+        match e {
+            G::Image { path, message } => FaceError::Io { path, message },
+            G::Io { path, source } => FaceError::io(path, source),
+            other => FaceError::Failed(other.to_string()),
+        }
+    }
+}
+
 impl FaceError {
     /// An I/O error on `path`.
     pub fn io(path: impl Into<PathBuf>, e: impl std::fmt::Display) -> Self {

@@ -3,7 +3,9 @@
 //! the landmarks, shaded renders of the textured model, the error map between the adapted and
 //! the generic face, and the landmark errors (`fit.csv`).
 //!
-//! A folder holds photos (`.png`, `.jpg`) and, for each photo to use, a `.pts` file of the same
+//! A folder holds photos (any of the
+//! [`PHOTO_EXTENSIONS`](crate::geometry::image::PHOTO_EXTENSIONS): PNG, JPEG, PPM/PGM, TIFF,
+//! BMP, WebP, TGA) and, for each photo to use, a `.pts` file of the same
 //! stem (68 iBUG points, 300-W convention), in the same folder or in a separate one. Photos
 //! without landmarks are skipped; a `.pts` file without its photo, or a folder without any
 //! pair, is an error naming it.
@@ -18,6 +20,7 @@ use super::error_map::{render_error_map, signed_distances};
 use super::export::{write_glb, write_textured_obj};
 use super::landmarks::{check_inside, landmark_positions, read_pts, PTS_PIXEL_ORIGIN};
 use super::model::FaceMesh;
+use super::people::{landmarked_photos, LandmarkedPhoto};
 use super::preview::{preview_camera, shaded_render};
 use super::texture_bake::bake_texture;
 use super::view_fit::View;
@@ -36,31 +39,35 @@ pub struct PhotoSet {
 }
 
 /// Reads the photos of `images` that have a `.pts` file of the same stem in `pts_dir` (default:
-/// the same folder). Errors name the folder or file: unreadable photo, malformed `.pts`, wrong
-/// point count, points outside the photo, no usable pair.
+/// the same folder), all as views of one person. Errors name the folder or file: unreadable
+/// photo, malformed `.pts`, wrong point count, points outside the photo, no usable pair.
 pub fn load_photos(images: &Path, pts_dir: Option<&Path>) -> Result<PhotoSet, FaceError> {
-    let pts_dir = pts_dir.unwrap_or(images);
-    let photos = crate::geometry::photo_files(images).map_err(|e| FaceError::io(images, e))?;
+    let pairs = landmarked_photos(images, pts_dir)?;
+    if pairs.is_empty() {
+        return Err(FaceError::Landmarks {
+            source_name: images.display().to_string(),
+            message: format!(
+                "no photo ({}) with a .pts file of the same stem in {}",
+                crate::geometry::image::photo_formats::photo_extensions_list(),
+                pts_dir.unwrap_or(images).display()
+            ),
+        });
+    }
+    read_photo_set(&pairs)
+}
+
+/// Reads `pairs` (photos and their landmark files) as one person's views. Errors name the
+/// file: unreadable photo, malformed `.pts`, wrong point count, points outside the photo.
+pub fn read_photo_set(pairs: &[LandmarkedPhoto]) -> Result<PhotoSet, FaceError> {
     let mut set = PhotoSet {
         names: Vec::new(),
         images: Vec::new(),
         views: Vec::new(),
     };
-    for photo in photos {
-        let stem = photo
-            .file_stem()
-            .and_then(|s| s.to_str())
-            .unwrap_or_default()
-            .to_string();
-        let pts = pts_dir.join(format!("{stem}.pts"));
-        if !pts.exists() {
-            continue;
-        }
-        let img = image::open(&photo)
-            .map_err(|e| FaceError::io(&photo, e))?
-            .into_rgb8();
-        let points = read_pts(&pts)?;
-        let source = pts.display().to_string();
+    for pair in pairs {
+        let img = crate::geometry::image::read_photo(&pair.photo)?;
+        let points = read_pts(&pair.pts)?;
+        let source = pair.pts.display().to_string();
         check_inside(&points, img.width(), img.height(), &source)?;
         let landmarks = points
             .iter()
@@ -69,36 +76,7 @@ pub fn load_photos(images: &Path, pts_dir: Option<&Path>) -> Result<PhotoSet, Fa
         set.views
             .push(View::new(source, landmarks, img.width(), img.height()));
         set.images.push(img);
-        set.names.push(stem);
-    }
-    // a landmark file without its photo is a mistake worth naming
-    let mut orphans: Vec<PathBuf> = std::fs::read_dir(pts_dir)
-        .map_err(|e| FaceError::io(pts_dir, e))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "pts"))
-        .filter(|p| {
-            let stem = p.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
-            !set.names.iter().any(|n| n == stem)
-        })
-        .collect();
-    orphans.sort();
-    if let Some(p) = orphans.first() {
-        return Err(FaceError::io(
-            p,
-            format!(
-                "no photo of this stem (.png, .jpg or .jpeg) in {}",
-                images.display()
-            ),
-        ));
-    }
-    if set.views.is_empty() {
-        return Err(FaceError::Landmarks {
-            source_name: images.display().to_string(),
-            message: format!(
-                "no photo (.png, .jpg) with a .pts file of the same stem in {}",
-                pts_dir.display()
-            ),
-        });
+        set.names.push(pair.stem.clone());
     }
     Ok(set)
 }

@@ -10,7 +10,8 @@
 //! - [`candide`], [`fap`], [`muscles`], [`expressions`], [`blendshapes`]: animation — the
 //!   CANDIDE-3 model, MPEG-4 FAPs on the mesh, Bézier muscles, named sliders, ARKit-52 export;
 //! - [`regions`], [`rbf`], [`contour`], [`view_fit`], [`adapt`], [`align`], [`fit_run`]:
-//!   adaptation of the generic mesh to a person's photos, and its outputs;
+//!   adaptation of the generic mesh to a person's photos, and its outputs; [`people`],
+//!   [`fit_people`]: which photos show which person, one fit per person;
 //! - [`texture_bake`], [`export`], [`error_map`]: texture from photos, OBJ+MTL and glTF files,
 //!   the signed error map between two surfaces;
 //! - [`head_pose`], [`skin`], [`sequence`], [`sequence_options`], [`sequence_files`]: synthetic
@@ -28,11 +29,13 @@ pub mod error_map;
 pub mod export;
 pub mod expressions;
 pub mod fap;
+pub mod fit_people;
 pub mod fit_run;
 pub mod head_pose;
 pub mod landmarks;
 pub mod model;
 pub mod muscles;
+pub mod people;
 pub mod preview;
 pub mod rbf;
 pub mod regions;

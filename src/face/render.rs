@@ -63,10 +63,11 @@ impl Texture {
         img
     }
 
-    /// Reads a PNG or JPEG; errors name the file.
+    /// Reads an image in any of the photo formats
+    /// ([`PHOTO_EXTENSIONS`](crate::geometry::image::PHOTO_EXTENSIONS)); errors name the file.
     pub fn load(path: &Path) -> Result<Texture, FaceError> {
-        let img = image::open(path).map_err(|e| FaceError::io(path, e))?;
-        Ok(Texture::from_image(&img.to_rgb8()))
+        let img = crate::geometry::image::read_photo(path)?;
+        Ok(Texture::from_image(&img))
     }
 
     /// Writes a PNG; errors name the file.

@@ -239,15 +239,16 @@ fn backgrounds(
     if photos.is_empty() {
         return Err(FaceError::io(
             dir,
-            "no background photos (*.jpg, *.png) in the folder",
+            format!(
+                "no background photos ({}) in the folder",
+                crate::geometry::image::photo_formats::photo_extensions_list()
+            ),
         ));
     }
     (0..options.cameras)
         .map(|c| {
             let path = &photos[(options.seed as usize + c) % photos.len()];
-            let img = image::open(path)
-                .map_err(|e| FaceError::io(path, e))?
-                .into_rgb8();
+            let img = crate::geometry::image::read_photo(path)?;
             let s = (w as f64 / img.width() as f64).max(h as f64 / img.height() as f64);
             let (nw, nh) = (
                 ((img.width() as f64 * s).ceil() as u32).max(w),

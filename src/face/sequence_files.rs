@@ -279,12 +279,11 @@ impl FaceSequence {
         })
     }
 
-    /// The image file of camera `c`, frame `k`.
+    /// The image file of camera `c`, frame `k`: `images/CAM/kkkk.png`, or the same stem in
+    /// another photo format ([`photo_with_stem`](crate::geometry::image::photo_with_stem)).
     pub fn image_path(&self, c: usize, k: usize) -> PathBuf {
-        self.dir
-            .join("images")
-            .join(&self.info.cameras[c])
-            .join(format!("{k:04}.png"))
+        let dir = self.dir.join("images").join(&self.info.cameras[c]);
+        crate::geometry::image::photo_with_stem_or(&dir, &format!("{k:04}"), "png")
     }
 
     /// The images of frame `k`, one per camera; errors name a missing or wrong-size file.
@@ -292,9 +291,7 @@ impl FaceSequence {
         (0..self.cameras.len())
             .map(|c| {
                 let path = self.image_path(c, k);
-                let img = image::open(&path)
-                    .map_err(|e| FaceError::io(&path, e))?
-                    .into_rgb8();
+                let img = crate::geometry::image::read_photo(&path)?;
                 if img.width() != self.info.width || img.height() != self.info.height {
                     return Err(FaceError::Failed(format!(
                         "{}: image is {}×{}, the sequence's {}×{}",

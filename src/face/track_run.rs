@@ -220,9 +220,7 @@ pub fn write_face_track_outputs(
         let edges = seq.model.edges();
         let (mut values, mut deformed, mut posed) = (vec![0.0; rig.len()], Vec::new(), Vec::new());
         for row in result.rows.iter().step_by(overlay_every) {
-            let mut img = image::open(seq.image_path(0, row.frame))
-                .map_err(|e| FaceError::io(seq.image_path(0, row.frame), e))?
-                .into_rgb8();
+            let mut img = crate::geometry::image::read_photo(&seq.image_path(0, row.frame))?;
             values.iter_mut().for_each(|v| *v = 0.0);
             for (&i, &v) in tracked_idx.iter().zip(&row.faps) {
                 values[i] = v;

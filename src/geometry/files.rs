@@ -1,7 +1,7 @@
 //! Where files are and how they are written: the shared data folder ([`data_dir`]), atomic
 //! file writing (temporary file in the same folder, then rename) shared by the mesh and
-//! picture writers, the checks a mesh must pass before it is written, and the list of the
-//! photos of a folder.
+//! picture writers and the checks a mesh must pass before it is written. (The photos of a
+//! folder: [`photo_files`](super::image::photo_files).)
 
 use std::fs;
 use std::io::{self, BufWriter, Write};
@@ -19,20 +19,6 @@ pub fn data_dir() -> std::path::PathBuf {
 /// `rel` under the shared data folder ([`data_dir`]), e.g. `data_path("bodies/makehuman")`.
 pub fn data_path(rel: impl AsRef<Path>) -> std::path::PathBuf {
     data_dir().join(rel)
-}
-
-/// The photos of `dir` (`.png`, `.jpg`, `.jpeg`, any case), sorted by path.
-pub fn photo_files(dir: &Path) -> io::Result<Vec<std::path::PathBuf>> {
-    let mut photos: Vec<std::path::PathBuf> = fs::read_dir(dir)?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            p.extension()
-                .and_then(|e| e.to_str())
-                .is_some_and(|e| matches!(e.to_ascii_lowercase().as_str(), "jpg" | "jpeg" | "png"))
-        })
-        .collect();
-    photos.sort();
-    Ok(photos)
 }
 
 /// Writes `path` through `write`, atomically: parent folders are created, the bytes go to a

@@ -8,7 +8,7 @@ use rhai::{Array, Dynamic, Map, INT};
 use super::convert::{rt_err, RResult};
 use super::{function, modules::ApiBuilder, register};
 use crate::facade::instances::window_instances;
-use crate::facade::report::{labelled_images, summarize, write_summary};
+use crate::facade::report::{labelled_images, labelled_photo, summarize, write_summary};
 use crate::facade::{Class, FacadeParse, FacadeScore, ImageReport, LabelMap};
 
 /// A facade's label map as a script handle.
@@ -29,6 +29,19 @@ pub fn register(engine: &mut ApiBuilder) {
     engine.register_type_with_name::<Labels>("FacadeLabels");
     engine.register_type_with_name::<FacadeParse>("FacadeParse");
     engine.register_type_with_name::<ImageReport>("FacadeReport");
+    function!(
+        engine,
+        "facade::photo",
+        ["dir: String", "name: String", "String"],
+        "The path of the photo `dir/images/NAME.EXT` of a labelled facade (a name from
+`facade::labelled`), whatever its format: `.jpg`, `.png`, `.ppm`, `.tif`, `.bmp`, `.webp`, …
+(`geometry::image::PHOTO_EXTENSIONS`); an error naming it when there is none.",
+        |dir: &str, name: &str| -> RResult<String> {
+            labelled_photo(Path::new(dir), name)
+                .map(|p| p.display().to_string())
+                .map_err(|e| rt_err(e.to_string()))
+        }
+    );
     function!(
         engine,
         "facade::labelled",

@@ -14,9 +14,11 @@ use crate::face::adapt::FaceFit;
 use crate::face::blendshapes::write_arkit_glb;
 use crate::face::expressions::Expressions;
 use crate::face::fap::FapRig;
-use crate::face::fit_run::{fit_folder, load_photos, write_fit_outputs, PhotoSet};
+use crate::face::fit_people::fit_people;
+use crate::face::fit_run::{load_photos, write_fit_outputs, FitReport, PhotoSet};
 use crate::face::model::FaceMesh;
 use crate::face::muscles::MuscleRig;
+use crate::face::people::Grouping;
 use crate::face::preview::expression_image;
 use crate::face::sequence::make_face_sequence;
 use crate::face::sequence_files::FaceSequence;
@@ -170,6 +172,7 @@ fn arkit(path: &str) -> RResult<()> {
 fn fit(images: &str, out: &str, m: &Map) -> RResult<Map> {
     let mut options = AdaptOptions::default();
     let (mut pts_dir, mut texture_size) = (None, 1024usize);
+    let (mut grouping, mut per_photo) = (Grouping::default(), false);
     for (k, v) in m {
         let k = k.as_str();
         match k {
@@ -178,22 +181,69 @@ fn fit(images: &str, out: &str, m: &Map) -> RResult<Map> {
             "support_fraction" => options.support_fraction = number(v, k)?,
             "rbf_smoothing" => options.rbf_smoothing = number(v, k)?,
             "contour_iterations" => options.contour_iterations = whole(v, k)? as usize,
+            "group" => grouping = Grouping::parse(&v.to_string()).map_err(rt_err)?,
+            "per_photo" => {
+                per_photo = v
+                    .as_bool()
+                    .map_err(|t| rt_err(format!("face_fit: `per_photo` must be a bool, not {t}")))?
+            }
             other => {
                 return Err(rt_err(format!(
-                    "face_fit: unknown option `{other}` (pts, texture_size, support_fraction, \
-                     rbf_smoothing, contour_iterations)"
+                    "face_fit: unknown option `{other}` (pts, group, per_photo, texture_size, \
+                     support_fraction, rbf_smoothing, contour_iterations)"
                 )))
             }
         }
     }
-    let (_, report) = fit_folder(
+    if per_photo {
+        grouping = Grouping::Photo;
+    }
+    let people = fit_people(
         Path::new(images),
         pts_dir.as_deref().map(Path::new),
         Path::new(out),
+        grouping,
         &options,
         texture_size,
     )
     .map_err(rt_err)?;
+    let reports: Vec<&FitReport> = people.iter().map(|p| &p.report).collect();
+    let all_errors: Vec<f64> = reports
+        .iter()
+        .flat_map(|r| r.errors_iod_pct.iter().copied())
+        .collect();
+    let mut r = fit_report_map(&FitReport {
+        names: reports.iter().flat_map(|r| r.names.clone()).collect(),
+        errors_iod_pct: all_errors,
+        texture_coverage: mean(reports.iter().map(|r| r.texture_coverage)),
+        mean_abs_change: mean(reports.iter().map(|r| r.mean_abs_change)),
+        files: reports.iter().flat_map(|r| r.files.clone()).collect(),
+    });
+    let list = people
+        .iter()
+        .map(|p| {
+            let mut m = fit_report_map(&p.report);
+            m.insert("name".into(), Dynamic::from(p.name.clone()));
+            m.insert("dir".into(), Dynamic::from(p.dir.display().to_string()));
+            m.insert(
+                "max_landmark_err_iod_pct".into(),
+                Dynamic::from_float(p.max_error_iod_pct()),
+            );
+            Dynamic::from_map(m)
+        })
+        .collect();
+    r.insert("people".into(), Dynamic::from_array(list));
+    Ok(r)
+}
+
+fn mean(values: impl Iterator<Item = f64>) -> f64 {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    sum / n.max(1) as f64
+}
+
+/// A fit report as the map `face::fit` returns: images, landmark_err_iod_pct, errors, names,
+/// texture_coverage, mean_abs_change_mm, files.
+fn fit_report_map(report: &FitReport) -> Map {
     let mut r = Map::new();
     r.insert(
         "images".into(),
@@ -232,7 +282,7 @@ fn fit(images: &str, out: &str, m: &Map) -> RResult<Map> {
         Dynamic::from_float(report.mean_abs_change * 1000.0),
     );
     r.insert("files".into(), Dynamic::from_int(report.files.len() as INT));
-    Ok(r)
+    r
 }
 
 /// A face adaptation driven step by step from a script (every step can be undone).
@@ -351,17 +401,26 @@ from the FAPs and muscles, and beside it a CSV of each shape's largest displacem
         alias = "face_fit",
         ["images: String", "out: String", "options: Map", "Map"],
         "Adapts the generic face (MediaPipe canonical mesh) to the photos of folder `images` that
-have a `.pts` file of the same stem (68 iBUG landmarks, 300-W convention): each photo's
-camera (pose, focal length) and the 3D characteristic points together, then the jaw-line
-contour in every photo, then an RBF deformation of the whole mesh (mouth and eye regions
-kept apart), then the cameras again. Writes under `out`: `face.obj`/`.mtl`/`.png` and
-`face.glb` textured from all photos, `overlay_NAME.png` per photo (the fitted mesh, given
-landmarks red, the model's green), `render_front/left/right.png`, `error_map.png` (adapted
-vs generic face: green outside, red inside) and `fit.csv`. Options: `pts` (folder of the
-.pts files, default `images`), `texture_size` (1024), `support_fraction` (RBF support as a
-fraction of the face width), `rbf_smoothing`, `contour_iterations`. Returns #{images,
-landmark_err_iod_pct (mean over photos, % of the outer-eye-corner distance), errors,
-names, texture_coverage, mean_abs_change_mm, files}.",
+have a `.pts` file of the same stem (68 iBUG landmarks, 300-W convention; photos in any of
+the formats of `geometry::image::PHOTO_EXTENSIONS`), one face per person. People: each
+subfolder is one person; photos directly in `images` named `<person>_<view>` (the stem cut
+at its last `_`) are grouped by person; the other photos there are one person named after
+the folder. Option `group: \"folder\"` makes every photo of `images` one person (subfolders
+ignored); `per_photo: true` (or `group: \"photo\"`) makes every photo a person. Per person:
+each photo's camera (pose, focal length) and the 3D characteristic points together, then the
+jaw-line contour in every photo, then an RBF deformation of the whole mesh (mouth and eye
+regions kept apart), then the cameras again. Writes under `out` (one person) or
+`out/<person>/` (several): `face.obj`/`.mtl`/`.png` and `face.glb` textured from that
+person's photos, `overlay_NAME.png` per photo (the fitted mesh, given landmarks red, the
+model's green), `render_front/left/right.png`, `error_map.png` (adapted vs generic face:
+green outside, red inside) and `fit.csv`; and under `out`, `photos.csv` (person, photo,
+landmark error) and `people.csv` (a summary row per person). Other options: `pts` (folder
+of the .pts files with the same subfolders, default `images`), `texture_size` (1024),
+`support_fraction` (RBF support as a fraction of the face width), `rbf_smoothing`,
+`contour_iterations`. Returns #{images, landmark_err_iod_pct (mean over all photos, % of
+the outer-eye-corner distance), errors, names, texture_coverage and mean_abs_change_mm
+(means over people), files, people: [#{name, dir, images, landmark_err_iod_pct,
+max_landmark_err_iod_pct, errors, names, texture_coverage, mean_abs_change_mm, files}]}.",
         |images: &str, out: &str, m: Map| fit(images, out, &m)
     );
     engine.register_type_with_name::<FaceFitSession>("FaceFit");
@@ -371,7 +430,8 @@ names, texture_coverage, mean_abs_change_mm, files}.",
         alias = "face_fit_start",
         ["images: String", "options: Map", "FaceFit"],
         "Starts a step-by-step adaptation of the generic face to the photos of `images` that have
-a `.pts` file of the same stem (option `pts`: the folder of the .pts files). Then call
+a `.pts` file of the same stem (option `pts`: the folder of the .pts files), all taken as
+views of one person (subfolders are not looked at). Then call
 `calibrate`, `adapt_contours`, `deform` and `refine_cameras` in that order; `undo` returns to
 the state before the last step; `write` writes the outputs as `face::fit` does.",
         |images: &str, m: Map| start(images, &m)

@@ -83,7 +83,8 @@ pub struct SequenceOptions {
     pub lighting_amplitude: f64,
     /// Fraction of each image covered by the static occluder (0..=0.5; 0 = none). Default 0.10.
     pub occluder_fraction: f64,
-    /// Folder of background photos (`*.jpg`, `*.jpeg`, `*.png`). Default
+    /// Folder of background photos (any of the
+    /// [`PHOTO_EXTENSIONS`](crate::geometry::image::PHOTO_EXTENSIONS)). Default
     /// `$EMILION_DATA/facades/labelmefacade/images`.
     pub backgrounds: PathBuf,
     /// MakeHuman data folder. Default `$EMILION_DATA/bodies/makehuman`.

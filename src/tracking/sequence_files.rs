@@ -8,8 +8,10 @@
 //! DIR/sequence.json          fps, frames, width, height, cameras ["cam0", …], motion file
 //!                            name, joint names, noise / lighting / occluder settings, seed
 //! DIR/cameras/cam0.json …    one camera file per camera (see `camera` module docs)
-//! DIR/images/cam0/0000.png … one PNG per camera and frame (4-digit frame numbers from 0)
-//! DIR/backgrounds/cam0.png … optional: each camera's empty scene (clean plate); without
+//! DIR/images/cam0/0000.png … one image per camera and frame (4-digit frame numbers from 0;
+//!                            PNG, or any other photo format of the same stem)
+//! DIR/backgrounds/cam0.png … optional: each camera's empty scene (clean plate, any photo
+//!                            format); without
 //!                            them the tracker takes the median of frames
 //! DIR/ground_truth.csv       optional: frame,time,pelvis_x,pelvis_y,pelvis_z,spine_x,…
 //!                            (metres, world frame, z up, TRACKING_JOINTS order), one row
@@ -268,9 +270,12 @@ impl Sequence {
         })
     }
 
-    /// Path of the image of camera `camera` (index) at frame `frame`.
+    /// Path of the image of camera `camera` (index) at frame `frame`: `images/NAME/kkkk.png`,
+    /// or the same stem in another photo format
+    /// ([`photo_with_stem`](crate::geometry::image::photo_with_stem)).
     pub fn image_path(&self, camera: usize, frame: usize) -> PathBuf {
-        image_path(&self.dir, &self.camera_names[camera], frame)
+        let dir = self.dir.join("images").join(&self.camera_names[camera]);
+        crate::geometry::image::photo_with_stem_or(&dir, &format!("{frame:04}"), "png")
     }
 
     /// Time of frame `frame`, seconds (`frame / fps`).
@@ -332,7 +337,7 @@ impl Sequence {
         Ok(img)
     }
 
-    /// The clean plates `backgrounds/NAME.png` (one per camera), or `None` when the folder
+    /// The clean plates `backgrounds/NAME.png` (one per camera, any photo format), or `None` when the folder
     /// is absent; an error when it is there but a plate is missing or of the wrong size.
     pub fn background_plates(&self) -> Result<Option<Vec<RgbImage>>, SequenceError> {
         let dir = self.dir.join("backgrounds");
@@ -343,7 +348,8 @@ impl Sequence {
             .map(|c| {
                 let name = &self.camera_names[c];
                 let what = format!("clean plate of camera {name}");
-                self.read_image(c, &dir.join(format!("{name}.png")), &what)
+                let path = crate::geometry::image::photo_with_stem_or(&dir, name, "png");
+                self.read_image(c, &path, &what)
             })
             .collect::<Result<Vec<_>, _>>()
             .map(Some)
@@ -503,13 +509,17 @@ pub fn read_joints_csv(path: &Path) -> Result<Vec<(usize, f64, JointFrame)>, Seq
     Ok(rows)
 }
 
-/// Photos of `dir` (`jpg`, `jpeg`, `png`), sorted by name.
+/// Photos of `dir` (any of the [`PHOTO_EXTENSIONS`](crate::geometry::image::PHOTO_EXTENSIONS)),
+/// sorted by name.
 pub(crate) fn list_photos(dir: &Path) -> Result<Vec<PathBuf>, SequenceError> {
     let photos = crate::geometry::photo_files(dir).map_err(io_err(dir))?;
     if photos.is_empty() {
         return Err(SequenceError::Missing {
             path: dir.to_path_buf(),
-            what: "background photos (*.jpg, *.png)".into(),
+            what: format!(
+                "background photos ({})",
+                crate::geometry::image::photo_formats::photo_extensions_list()
+            ),
         });
     }
     Ok(photos)

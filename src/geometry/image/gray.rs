@@ -114,12 +114,9 @@ pub fn luma(rgb: [f32; 3]) -> f32 {
     0.299 * rgb[0] + 0.587 * rgb[1] + 0.114 * rgb[2]
 }
 
-/// Reads an image file (JPEG or PNG) as 8-bit RGB; the error names the file.
+/// Reads a photo as 8-bit RGB, any of the formats of
+/// [`PHOTO_EXTENSIONS`](super::photo_formats::PHOTO_EXTENSIONS); the error names the file
+/// ([`read_photo`](super::photo_formats::read_photo)).
 pub fn read_rgb(path: &Path) -> Result<RgbImage, GeometryError> {
-    Ok(image::open(path)
-        .map_err(|e| GeometryError::Image {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })?
-        .into_rgb8())
+    super::photo_formats::read_photo(path)
 }
