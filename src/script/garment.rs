@@ -2,13 +2,13 @@
 //! `Pattern` handle, and `garment::dress`, which meshes, pre-positions and sews a pattern on the
 //! mannequin into a `Simulation`.
 
-use std::path::Path;
 use std::sync::Arc;
 
 use rhai::{Map, INT};
 
 use super::convert::{count, num, rt_err, update_from_map, RResult};
 use super::kes::KesFabric;
+use super::paths::resolve;
 use super::{function, modules::ApiBuilder, register, Fabric, SimHandle};
 use crate::body::Mannequin;
 use crate::cloth::{FabricParameters, MaterialLaw, SimulationParameters};
@@ -25,8 +25,10 @@ fn perr(e: PatternError) -> Box<rhai::EvalAltResult> {
 }
 
 /// Reads a pattern by its file's extension.
+/// A relative `path` is taken from the running script's folder.
 fn read_any(path: &str) -> Result<Pattern, PatternError> {
-    let p = Path::new(path);
+    let file = resolve(path);
+    let p = file.as_path();
     if path.ends_with(".garment.json") {
         read_garment(p)
     } else if path.ends_with(".json") {
@@ -50,10 +52,10 @@ fn dress_on_mannequin(
     mut m: Map,
 ) -> RResult<SimHandle> {
     let dir = match m.remove("makehuman") {
-        Some(d) => d
-            .into_string()
-            .map_err(|t| rt_err(format!("`makehuman` must be a string, got {t}")))?
-            .into(),
+        Some(d) => resolve(
+            &d.into_string()
+                .map_err(|t| rt_err(format!("`makehuman` must be a string, got {t}")))?,
+        ),
         None => crate::geometry::files::data_path("bodies/makehuman"),
     };
     let mut sp = SimulationParameters::default();
@@ -113,7 +115,7 @@ pub fn register(engine: &mut ApiBuilder) {
     register!(engine, "save_sheet", ["pattern: Pattern", "path: String", "()"],
         "Writes the pattern sheet (`.png` or `.svg`): the pieces side by side at 400 pixels per metre,\nnames, grain lines, notches, and each seam's two edges in its colour with its number.",
         |p: &mut PatternHandle, path: &str| -> RResult<()> {
-            crate::garment::write_pattern_sheet(Path::new(path), &p.0, 400.0).map_err(rt_err)
+            crate::garment::write_pattern_sheet(&resolve(path), &p.0, 400.0).map_err(rt_err)
         });
     register!(
         engine,
