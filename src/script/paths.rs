@@ -14,7 +14,6 @@ use std::path::{Path, PathBuf};
 use rhai::ImmutableString;
 
 use super::register;
-use super::run::parse_value;
 use crate::geometry::files::data_dir;
 
 /// The script being run: its folder, its name and the relative paths given on the command line.
@@ -44,17 +43,17 @@ impl Drop for ContextGuard {
 }
 
 impl ScriptContext {
-    /// The context of the script file `script` run with the `--set` values `sets`.
-    pub fn new(script: &Path, sets: &[(String, String)]) -> Self {
+    /// The context of the script file `script` run with `command_line`, the string values
+    /// given by `--set` (a relative one is a path of the working directory).
+    pub fn new<'a>(script: &Path, command_line: impl IntoIterator<Item = &'a str>) -> Self {
         let file = std::path::absolute(script).unwrap_or_else(|_| script.to_path_buf());
         let dir = file.parent().map_or_else(working_dir, Path::to_path_buf);
         let name = script
             .file_stem()
             .map_or_else(|| "script".into(), |s| s.to_string_lossy().into_owned());
-        let command_line = sets
-            .iter()
-            .filter(|(_, v)| parse_value(v).is_string())
-            .map(|(_, v)| PathBuf::from(v))
+        let command_line = command_line
+            .into_iter()
+            .map(PathBuf::from)
             .filter(|p| p.is_relative() && !p.as_os_str().is_empty())
             .collect();
         ScriptContext {
@@ -157,16 +156,10 @@ pub fn register(engine: &mut rhai::Engine) {
 mod tests {
     use super::*;
 
-    fn sets(v: &[(&str, &str)]) -> Vec<(String, String)> {
-        v.iter()
-            .map(|(k, v)| (k.to_string(), v.to_string()))
-            .collect()
-    }
-
     #[test]
     fn relative_paths_follow_the_script() {
         let script = Path::new("/somewhere/scripts/walk.rhai");
-        let _g = ScriptContext::new(script, &sets(&[("out", "results"), ("n", "3")])).enter();
+        let _g = ScriptContext::new(script, ["results"]).enter();
         assert_eq!(
             resolve("patterns/a.json"),
             Path::new("/somewhere/scripts/patterns/a.json")
@@ -197,7 +190,7 @@ mod tests {
         assert_eq!(script_dir(), std::env::current_dir().unwrap());
         assert_eq!(out_dir(), std::env::current_dir().unwrap().join("out"));
         {
-            let _g = ScriptContext::new(Path::new("/s/x.rhai"), &[]).enter();
+            let _g = ScriptContext::new(Path::new("/s/x.rhai"), []).enter();
             assert_eq!(resolve("a"), Path::new("/s/a"));
         }
         assert_eq!(

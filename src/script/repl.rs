@@ -169,7 +169,7 @@ impl Session {
     /// Runs a script file in the session (its variables and functions stay); its relative
     /// paths are taken from its folder, those typed afterwards from the working directory.
     pub fn run_init(&mut self, path: &Path) -> Result<(), ScriptError> {
-        let _context = ScriptContext::new(path, &[]).enter();
+        let _context = ScriptContext::new(path, []).enter();
         let file = path.display().to_string();
         let src = std::fs::read_to_string(path).map_err(|e| ScriptError {
             file: file.clone(),

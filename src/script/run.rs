@@ -151,6 +151,11 @@ pub fn run_file(path: &Path, sets: &[(String, String)]) -> Result<(), ScriptErro
         source_line: None,
     })?;
     let engine = build_engine();
-    let _context = ScriptContext::new(path, sets).enter();
+    // the `--set` strings: paths among them are the working directory's
+    let strings = sets
+        .iter()
+        .map(|(_, v)| v.as_str())
+        .filter(|v| parse_value(v).is_string());
+    let _context = ScriptContext::new(path, strings).enter();
     run_source(&engine, &file, &source, &mut scope)
 }
