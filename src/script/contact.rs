@@ -67,7 +67,7 @@ pub fn register(engine: &mut Engine) {
         });
     register!(engine, "add_mannequin", ["sim: Simulation", "options: Map", "int"],
         "Adds the MakeHuman mannequin (feet on z = 0, facing −y) as a body, animated by a BVH clip:\n`#{motion: \"path.bvh\", in_place: true, start: 0.0, blend: 0.0, makehuman: \"dir\"}`. Without\n`motion` it stands still in its rest pose. With `blend` > 0 it moves from its rest pose into the\nclip's first frame over `blend` seconds before the clip plays (dress it at rest, then move);
-`arm_spread` (degrees) tilts the upper arms outward so the hands clear wide hips. `makehuman` defaults to `$EMILION_DATA/bodies/makehuman`\n(`$EMILION_DATA` defaults to `../shared/data`); `in_place` removes the walk's forward travel;\n`start` is the clip time at simulation time 0. Returns its body index.",
+`arm_spread` (degrees) tilts the upper arms outward so the hands clear wide hips. `makehuman` defaults to `$EMILION_DATA/bodies/makehuman`\n(`data_dir()`: `$EMILION_DATA`, else `../shared/data` from the repository); `in_place` removes the walk's forward travel;\n`start` is the clip time at simulation time 0. Returns its body index.",
         |h: &mut SimHandle, m: Map| -> RResult<INT> {
             const KEYS: [&str; 6] = ["motion", "in_place", "start", "makehuman", "blend", "arm_spread"];
             if let Some(k) = m.keys().find(|k| !KEYS.contains(&k.as_str())) {
