@@ -132,9 +132,15 @@ fn steps_can_be_undone_from_a_script() {
         .starts_with("landmark_err_iod_pct="));
     // undo with nothing done is an error the script sees
     let script = out.join("undo.rhai");
+    // the script lives in the temporary folder: its relative paths would be taken from there
     std::fs::write(
         &script,
-        "let f = face_fit_start(\"../shared/data/images\", #{ pts: \"tests/data/faces\" });\nf.undo();\n",
+        format!(
+            "let f = face_fit_start(data_dir() + \"/images\", #{{ pts: \"{}\" }});\nf.undo();\n",
+            Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("tests/data/faces")
+                .display()
+        ),
     )
     .unwrap();
     let (ok, _, stderr) = run(script.to_str().unwrap(), &[]);

@@ -10,10 +10,19 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use super::{GeometryError, Vec3};
 
-/// The shared data folder (meshes, bodies, motion clips, photos, fabric measurements):
-/// `$EMILION_DATA`, else `../shared/data` (relative to the working directory).
+/// The shared data folder (meshes, bodies, motion clips, photos, fabric measurements), absolute:
+/// `$EMILION_DATA` (a relative value is the working directory's), else `shared/data` beside the
+/// repository emilion was built from (`../shared/data` from the repository root), whatever the
+/// working directory.
 pub fn data_dir() -> std::path::PathBuf {
-    std::env::var_os("EMILION_DATA").map_or_else(|| "../shared/data".into(), Into::into)
+    let dir: std::path::PathBuf = match std::env::var_os("EMILION_DATA") {
+        Some(d) => d.into(),
+        None => {
+            let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+            repo.parent().unwrap_or(repo).join("shared/data")
+        }
+    };
+    std::path::absolute(&dir).unwrap_or(dir)
 }
 
 /// `rel` under the shared data folder ([`data_dir`]), e.g. `data_path("bodies/makehuman")`.

@@ -2,13 +2,12 @@
 //! mannequin), their friction, particles pinned to bodies, contact settings and the contact
 //! read-outs (distance to bodies, penetrations, self-intersections).
 
-use std::path::Path;
-
 use rhai::{Array, Dynamic, Engine, Map, INT};
 
 use super::convert::{
     export_frame, finite, index, indices, rt_err, to_map, update_from_map, vec3, RResult,
 };
+use super::paths::{resolve, resolve_opt};
 use super::{register, SimHandle};
 use crate::body::RetargetOptions;
 use crate::cloth::{ClothError, Simulation};
@@ -46,13 +45,14 @@ fn save_body_obj(sim: &Simulation, b: INT, path: &str, frame: ExportFrame) -> RR
         .ok_or_else(|| rt_err(format!("body {b} does not exist ({n} bodies)")))?;
     let (lo, hi) = crate::geometry::mesh::bounds(&sim.state.x);
     let (p, t) = crate::contact::tessellate::body_mesh(body, &lo, &hi);
-    if let Some(d) = Path::new(path)
+    let path = resolve(path);
+    if let Some(d) = path
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
     {
         std::fs::create_dir_all(d).map_err(|e| rt_err(format!("{}: {e}", d.display())))?;
     }
-    crate::geometry::write_obj(Path::new(path), &p, &t, None, frame)?;
+    crate::geometry::write_obj(&path, &p, &t, None, frame)?;
     Ok(())
 }
 
@@ -85,12 +85,13 @@ pub fn register(engine: &mut Engine) {
     register!(engine, "add_obstacle", ["sim: Simulation", "path: String", "int"],
         "Adds a static triangle mesh read from an OBJ file (metres) as a body. Degenerate triangles\nare dropped; a non-manifold or inconsistently wound mesh is an error naming the edge.\nReturns its body index.",
         |h: &mut SimHandle, path: &str| -> RResult<INT> {
-            let (positions, triangles) = read_obj_surface(Path::new(path))?;
-            add_body(h, MeshBody::new(path, positions, &triangles).map(Body::mesh))
+            let path = resolve(path);
+            let (positions, triangles) = read_obj_surface(&path)?;
+            add_body(h, MeshBody::new(&path.display().to_string(), positions, &triangles).map(Body::mesh))
         });
     register!(engine, "add_mannequin", ["sim: Simulation", "options: Map", "int"],
         "Adds the MakeHuman mannequin (feet on z = 0, facing −y) as a body, animated by a BVH clip:\n`#{motion: \"path.bvh\", in_place: true, start: 0.0, blend: 0.0, makehuman: \"dir\"}`. Without\n`motion` it stands still in its rest pose. With `blend` > 0 it moves from its rest pose into the\nclip's first frame over `blend` seconds before the clip plays (dress it at rest, then move);
-`arm_spread` (degrees) tilts the upper arms outward so the hands clear wide hips. `makehuman` defaults to `$EMILION_DATA/bodies/makehuman`\n(`$EMILION_DATA` defaults to `../shared/data`); `in_place` removes the walk's forward travel;\n`start` is the clip time at simulation time 0. Returns its body index.",
+`arm_spread` (degrees) tilts the upper arms outward so the hands clear wide hips. `makehuman` defaults to `$EMILION_DATA/bodies/makehuman`\n(`data_dir()`: `$EMILION_DATA`, else `../shared/data` from the repository); `in_place` removes the walk's forward travel;\n`start` is the clip time at simulation time 0. Returns its body index.",
         |h: &mut SimHandle, m: Map| -> RResult<INT> {
             const KEYS: [&str; 6] = ["motion", "in_place", "start", "makehuman", "blend", "arm_spread"];
             if let Some(k) = m.keys().find(|k| !KEYS.contains(&k.as_str())) {
@@ -99,8 +100,8 @@ pub fn register(engine: &mut Engine) {
             let text = |k: &str| -> RResult<Option<String>> {
                 m.get(k).map(|v| v.clone().into_string().map_err(|t| rt_err(format!("`{k}` must be a string, got {t}")))).transpose()
             };
-            let dir = text("makehuman")?.map_or_else(|| data_path("bodies/makehuman"), Into::into);
-            let motion = text("motion")?;
+            let dir = resolve_opt(text("makehuman")?.as_deref()).unwrap_or_else(|| data_path("bodies/makehuman"));
+            let motion = resolve_opt(text("motion")?.as_deref());
             let mut opt = RetargetOptions::default();
             if let Some(v) = m.get("in_place") {
                 opt.in_place = v.as_bool().map_err(|t| rt_err(format!("`in_place` must be true or false, got {t}")))?;
@@ -112,7 +113,7 @@ pub fn register(engine: &mut Engine) {
                 opt.arm_spread_deg = finite(v, "arm_spread")?;
             }
             let blend = m.get("blend").map_or(Ok(0.0), |v| finite(v, "blend"))?;
-            add_body(h, mannequin_body(&dir, motion.as_deref().map(Path::new), opt, blend))
+            add_body(h, mannequin_body(&dir, motion.as_deref(), opt, blend))
         });
     register!(engine, "set_friction", ["sim: Simulation", "body: int", "static: float", "kinetic: float"],
         "Sets a body's static and kinetic friction coefficients (each combined with the fabric's by\ntheir mean; set the fabric's with `set_contact(#{mu_static: .., mu_kinetic: ..})`).",

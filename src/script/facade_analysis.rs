@@ -2,13 +2,13 @@
 //! its read-outs, its parse and the label map brought into its frame for scoring, and its
 //! output files.
 
-use std::path::Path;
 use std::sync::Arc;
 
 use rhai::{Array, Dynamic, Map, INT};
 
 use super::convert::{finite, rt_err, RResult};
 use super::facade::Labels;
+use super::paths::{resolve, resolve_opt};
 use super::{function, getter, modules::ApiBuilder, register};
 use crate::facade::analysis::{analyze, Analysis, Options, Rectify};
 use crate::facade::facade_mesh::MeshParams;
@@ -140,14 +140,16 @@ fn from_rules(rules: &str, out: &str, stem: &str, m: &Map) -> RResult<Array> {
             }
         }
     }
-    let text = std::fs::read_to_string(rules).map_err(|e| rt_err(format!("{rules}: {e}")))?;
-    let grammar = Grammar::parse(&text).map_err(|e| rt_err(format!("{rules}: {e}")))?;
+    let rules = resolve(rules);
+    let name = rules.display();
+    let text = std::fs::read_to_string(&rules).map_err(|e| rt_err(format!("{name}: {e}")))?;
+    let grammar = Grammar::parse(&text).map_err(|e| rt_err(format!("{name}: {e}")))?;
     let params = MeshParams::new(scale, grammar.size);
     let files = write_generated(
         &grammar,
         &params,
-        texture.as_deref().map(Path::new),
-        Path::new(out),
+        resolve_opt(texture.as_deref()).as_deref(),
+        &resolve(out),
         stem,
         &opts,
     )
@@ -159,7 +161,7 @@ fn from_rules(rules: &str, out: &str, stem: &str, m: &Map) -> RResult<Array> {
 }
 
 fn run(path: &str, o: &Options) -> RResult<FacadeAnalysis> {
-    analyze(Path::new(path), o)
+    analyze(&resolve(path), o)
         .map(|a| FacadeAnalysis(Arc::new(a)))
         .map_err(|e| rt_err(e.to_string()))
 }
@@ -363,7 +365,7 @@ STEM_labels.png, STEM.cga (the rules) and 3D facades at 1×, 0.75× and 1.5× th
 (STEM_w1.obj/.mtl/.glb, …, textured with the rectified photo) with a render of each
 (STEM_w1.png, …). Returns the paths.",
         |a: &mut FacadeAnalysis, dir: &str, stem: &str| -> RResult<Array> {
-            let files = write_outputs(&a.0, Path::new(dir), stem, &OutputOptions::default())
+            let files = write_outputs(&a.0, &resolve(dir), stem, &OutputOptions::default())
                 .map_err(|e| rt_err(e.to_string()))?;
             Ok(files
                 .into_iter()

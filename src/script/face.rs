@@ -7,6 +7,7 @@ use indicatif::ProgressBar;
 use rhai::{Dynamic, Map, INT};
 
 use super::convert::{rt_err, RResult};
+use super::paths::{resolve, resolve_opt, resolve_text};
 use super::tracking_sequence::{number, whole};
 use super::{function, modules::ApiBuilder, register};
 use crate::face::adapt::AdaptOptions;
@@ -43,9 +44,9 @@ fn sequence_options(m: &Map) -> RResult<FaceSequenceOptions> {
             "light" => o.light = number(v, k)?,
             "texture_size" => o.texture_size = whole(v, k)? as usize,
             "seed" => o.seed = whole(v, k)?,
-            "texture" => o.texture = Some(v.to_string()),
-            "model" => o.model = Some(v.to_string()),
-            "backgrounds" => o.backgrounds = Some(v.to_string()),
+            "texture" => o.texture = Some(resolve_text(&v.to_string())),
+            "model" => o.model = Some(resolve_text(&v.to_string())),
+            "backgrounds" => o.backgrounds = Some(resolve_text(&v.to_string())),
             "faps" => {
                 let arr = v
                     .read_lock::<rhai::Array>()
@@ -69,7 +70,7 @@ fn sequence_options(m: &Map) -> RResult<FaceSequenceOptions> {
 
 fn make(out: &str, m: &Map) -> RResult<Map> {
     let o = sequence_options(m)?;
-    let info = make_face_sequence(Path::new(out), &o).map_err(rt_err)?;
+    let info = make_face_sequence(&resolve(out), &o).map_err(rt_err)?;
     let mut r = Map::new();
     r.insert("frames".into(), Dynamic::from_int(info.frames as INT));
     r.insert(
@@ -115,7 +116,7 @@ fn track(seq_dir: &str, out: &str, m: &Map) -> RResult<Map> {
             }
         }
     }
-    let seq = FaceSequence::open(Path::new(seq_dir)).map_err(rt_err)?;
+    let seq = FaceSequence::open(&resolve(seq_dir)).map_err(rt_err)?;
     let total = frames.map_or(seq.info.frames, |f| f.min(seq.info.frames));
     let bar = std::io::stderr()
         .is_terminal()
@@ -130,7 +131,7 @@ fn track(seq_dir: &str, out: &str, m: &Map) -> RResult<Map> {
         b.finish_and_clear();
     }
     let files =
-        write_face_track_outputs(&seq, &result, Path::new(out), overlay_every).map_err(rt_err)?;
+        write_face_track_outputs(&seq, &result, &resolve(out), overlay_every).map_err(rt_err)?;
     let f = |x: Option<f64>| x.map_or(Dynamic::UNIT, Dynamic::from_float);
     let mut r = Map::new();
     r.insert("frames".into(), Dynamic::from_int(result.rows.len() as INT));
@@ -144,8 +145,8 @@ fn track(seq_dir: &str, out: &str, m: &Map) -> RResult<Map> {
 }
 
 /// Creates the folder of `path`.
-fn parent_dir(path: &str) -> RResult<()> {
-    if let Some(dir) = Path::new(path).parent() {
+fn parent_dir(path: &Path) -> RResult<()> {
+    if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).map_err(|e| rt_err(format!("{}: {e}", dir.display())))?;
     }
     Ok(())
@@ -157,16 +158,19 @@ fn expression_png(path: &str, m: &Map, yaw_deg: f64) -> RResult<()> {
         .map(|(k, v)| Ok((k.to_string(), number(v, k)?)))
         .collect::<RResult<Vec<_>>>()?;
     let img = expression_image(&values, 512, yaw_deg).map_err(rt_err)?;
-    parent_dir(path)?;
-    img.save(path).map_err(|e| rt_err(format!("{path}: {e}")))
+    let path = resolve(path);
+    parent_dir(&path)?;
+    img.save(&path)
+        .map_err(|e| rt_err(format!("{}: {e}", path.display())))
 }
 
 fn arkit(path: &str) -> RResult<()> {
     let mesh = FaceMesh::mediapipe().map_err(rt_err)?;
     let faps = FapRig::new(&mesh).map_err(rt_err)?;
     let muscles = MuscleRig::mediapipe(&mesh).map_err(rt_err)?;
-    parent_dir(path)?;
-    write_arkit_glb(Path::new(path), &mesh, &faps, &muscles).map_err(rt_err)
+    let path = resolve(path);
+    parent_dir(&path)?;
+    write_arkit_glb(&path, &mesh, &faps, &muscles).map_err(rt_err)
 }
 
 fn fit(images: &str, out: &str, m: &Map) -> RResult<Map> {
@@ -199,9 +203,9 @@ fn fit(images: &str, out: &str, m: &Map) -> RResult<Map> {
         grouping = Grouping::Photo;
     }
     let people = fit_people(
-        Path::new(images),
-        pts_dir.as_deref().map(Path::new),
-        Path::new(out),
+        &resolve(images),
+        resolve_opt(pts_dir.as_deref()).as_deref(),
+        &resolve(out),
         grouping,
         &options,
         texture_size,
@@ -304,8 +308,8 @@ fn start(images: &str, m: &Map) -> RResult<FaceFitSession> {
             }
         }
     }
-    let photos =
-        load_photos(Path::new(images), pts_dir.as_deref().map(Path::new)).map_err(rt_err)?;
+    let pts_dir = resolve_opt(pts_dir.as_deref());
+    let photos = load_photos(&resolve(images), pts_dir.as_deref()).map_err(rt_err)?;
     let generic = FaceMesh::mediapipe().map_err(rt_err)?;
     let fit = FaceFit::new(&generic, &photos.views, &AdaptOptions::default()).map_err(rt_err)?;
     Ok(FaceFitSession { fit, photos })
@@ -508,7 +512,7 @@ textured OBJ and glb, overlays, renders, error map, fit.csv); returns #{images,
 landmark_err_iod_pct, texture_coverage, files}.",
         |s: &mut FaceFitSession, out: &str| -> RResult<Map> {
             let report =
-                write_fit_outputs(&s.fit, &s.photos, Path::new(out), 1024).map_err(rt_err)?;
+                write_fit_outputs(&s.fit, &s.photos, &resolve(out), 1024).map_err(rt_err)?;
             let mut r = Map::new();
             r.insert(
                 "images".into(),

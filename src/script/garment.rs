@@ -2,13 +2,13 @@
 //! `Pattern` handle, written back as DXF-AAMA (`save_dxf`), and `garment::dress`, which
 //! meshes, pre-positions and sews a pattern on the mannequin into a `Simulation`.
 
-use std::path::Path;
 use std::sync::Arc;
 
 use rhai::{Map, INT};
 
 use super::convert::{count, num, rt_err, update_from_map, RResult};
 use super::kes::KesFabric;
+use super::paths::resolve;
 use super::{function, modules::ApiBuilder, register, Fabric, SimHandle};
 use crate::body::Mannequin;
 use crate::cloth::{FabricParameters, MaterialLaw, SimulationParameters};
@@ -26,8 +26,10 @@ fn perr(e: PatternError) -> Box<rhai::EvalAltResult> {
 }
 
 /// Reads a pattern by its file's extension.
+/// A relative `path` is taken from the running script's folder.
 fn read_any(path: &str) -> Result<Pattern, PatternError> {
-    let p = Path::new(path);
+    let file = resolve(path);
+    let p = file.as_path();
     if path.ends_with(".garment.json") {
         read_garment(p)
     } else if path.ends_with(".json") {
@@ -51,10 +53,10 @@ fn dress_on_mannequin(
     mut m: Map,
 ) -> RResult<SimHandle> {
     let dir = match m.remove("makehuman") {
-        Some(d) => d
-            .into_string()
-            .map_err(|t| rt_err(format!("`makehuman` must be a string, got {t}")))?
-            .into(),
+        Some(d) => resolve(
+            &d.into_string()
+                .map_err(|t| rt_err(format!("`makehuman` must be a string, got {t}")))?,
+        ),
         None => crate::geometry::files::data_path("bodies/makehuman"),
     };
     let mut sp = SimulationParameters::default();
@@ -114,12 +116,12 @@ pub fn register(engine: &mut ApiBuilder) {
     register!(engine, "save_sheet", ["pattern: Pattern", "path: String", "()"],
         "Writes the pattern sheet (`.png` or `.svg`): the pieces side by side at 400 pixels per metre,\nnames, grain lines, notches, and each seam's two edges in its colour with its number.",
         |p: &mut PatternHandle, path: &str| -> RResult<()> {
-            crate::garment::write_pattern_sheet(Path::new(path), &p.0, 400.0).map_err(rt_err)
+            crate::garment::write_pattern_sheet(&resolve(path), &p.0, 400.0).map_err(rt_err)
         });
     register!(engine, "save_dxf", ["pattern: Pattern", "path: String", "()"],
         "Writes the pattern as a DXF-AAMA file (ASCII DXF R12) in millimetres: one block per piece\nwith its cut line (layer 1), sewing line (14), turn and curve points (2, 3), notches (4),\ngrain line (7), and as annotation text (layer 15) its corner names and placement; the\nseams as `Seam:` annotation texts. `garment::pattern` reads it back into the same pattern.",
         |p: &mut PatternHandle, path: &str| -> RResult<()> {
-            write_pattern_dxf_with(&p.0, Path::new(path), &DxfOptions::default()).map_err(perr)
+            write_pattern_dxf_with(&p.0, &resolve(path), &DxfOptions::default()).map_err(perr)
         });
     register!(engine, "save_dxf", ["pattern: Pattern", "path: String", "options: Map", "()"],
         "As `save_dxf(path)` with options: `units` (\"mm\" default, \"cm\", \"m\" or \"in\"; written as\n`$INSUNITS` and the AAMA `Units:` text).",
@@ -140,7 +142,7 @@ pub fn register(engine: &mut ApiBuilder) {
                     }
                 }
             }
-            write_pattern_dxf_with(&p.0, Path::new(path), &options).map_err(perr)
+            write_pattern_dxf_with(&p.0, &resolve(path), &options).map_err(perr)
         });
     register!(
         engine,

@@ -1,11 +1,10 @@
 //! Script bindings that measure a cloth (compressed springs, wrinkles along a line) and plot
 //! series the script collected (PNG, SVG and CSV).
 
-use std::path::Path;
-
 use rhai::{Array, Dynamic, Map, INT};
 
 use super::convert::{finite, index, non_negative, rt_err, RResult};
+use super::paths::resolve;
 use super::{function, modules::ApiBuilder, register, SimHandle};
 use crate::cloth::buckling::wrinkles::{compressed_springs, energy_parts, wrinkles_along};
 use crate::geometry::Vec3;
@@ -124,7 +123,7 @@ pub fn register(engine: &mut ApiBuilder) {
                     style,
                 });
             }
-            let stem = Path::new(stem);
+            let stem = resolve(stem);
             if let Some(d) = stem.parent().filter(|d| !d.as_os_str().is_empty()) {
                 std::fs::create_dir_all(d).map_err(|e| rt_err(format!("{}: {e}", d.display())))?;
             }
@@ -136,7 +135,7 @@ pub fn register(engine: &mut ApiBuilder) {
                 y_label: text("y_label")?,
                 series,
             };
-            let (png, svg) = write_plot_pair(stem, &spec).map_err(|e| rt_err(e.to_string()))?;
+            let (png, svg) = write_plot_pair(&stem, &spec).map_err(|e| rt_err(e.to_string()))?;
             Ok([png, svg, csv]
                 .iter()
                 .map(|p| Dynamic::from(p.display().to_string()))

@@ -14,6 +14,8 @@
 //! - [`kes`]: the virtual Kawabata lab (fabric files, rigs, fitting, summaries);
 //! - [`facade`], [`facade_analysis`]: facade label maps, scores and the photo pipeline;
 //! - [`tracking_sequence`], [`tracking`]: synthetic multi-camera sequences and the body tracker;
+//! - [`paths`]: where a script's relative paths lead (its own folder), `script_dir()`,
+//!   `data_dir()`, `out_dir()`;
 //! - [`run`], [`repl`], [`docs`]: running a file, the interactive loop, API documentation.
 //!
 //! Big objects cross into Rhai as shared handles (`Shared<Locked<_>>`), never copied per call.
@@ -30,6 +32,7 @@ pub mod kes;
 pub mod measure;
 pub mod modules;
 pub mod output;
+pub mod paths;
 pub mod repl;
 pub mod run;
 pub mod sim;
@@ -156,6 +159,7 @@ pub fn build_engine_with(limits: EngineLimits) -> Engine {
     face::register(&mut engine);
     tracking_sequence::register(&mut engine);
     kes::register(&mut engine);
+    paths::register(&mut engine);
     engine.finish()
 }
 

@@ -14,6 +14,7 @@ use rustyline::hint::Hinter;
 use rustyline::validate::Validator;
 use rustyline::{Context, Editor, Helper};
 
+use super::paths::ScriptContext;
 use super::run::ScriptError;
 use super::{build_engine, describe, docs, function_names};
 
@@ -165,8 +166,10 @@ impl Session {
         Flow::Continue
     }
 
-    /// Runs a script file in the session (its variables and functions stay).
+    /// Runs a script file in the session (its variables and functions stay); its relative
+    /// paths are taken from its folder, those typed afterwards from the working directory.
     pub fn run_init(&mut self, path: &Path) -> Result<(), ScriptError> {
+        let _context = ScriptContext::new(path, []).enter();
         let file = path.display().to_string();
         let src = std::fs::read_to_string(path).map_err(|e| ScriptError {
             file: file.clone(),

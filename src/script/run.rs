@@ -7,6 +7,7 @@ use std::path::Path;
 use rhai::{Dynamic, Engine, EvalAltResult, Position, Scope};
 
 use super::build_engine;
+use super::paths::ScriptContext;
 
 /// A failed script: where, what, and the source line it points at.
 #[derive(Debug, Clone)]
@@ -132,7 +133,9 @@ pub fn run_source(
         .map_err(|e| ScriptError::from_rhai(file, source, *e))
 }
 
-/// Runs a script file with a fresh engine, `sets` defined as constants beforehand.
+/// Runs a script file with a fresh engine, `sets` defined as constants beforehand. Relative
+/// paths in the script are taken from its folder, those given by `sets` from the working
+/// directory (see [`paths`](super::paths)).
 pub fn run_file(path: &Path, sets: &[(String, String)]) -> Result<(), ScriptError> {
     let file = path.display().to_string();
     let source = std::fs::read_to_string(path).map_err(|e| ScriptError {
@@ -148,5 +151,11 @@ pub fn run_file(path: &Path, sets: &[(String, String)]) -> Result<(), ScriptErro
         source_line: None,
     })?;
     let engine = build_engine();
+    // the `--set` strings: paths among them are the working directory's
+    let strings = sets
+        .iter()
+        .map(|(_, v)| v.as_str())
+        .filter(|v| parse_value(v).is_string());
+    let _context = ScriptContext::new(path, strings).enter();
     run_source(&engine, &file, &source, &mut scope)
 }

@@ -1,10 +1,9 @@
 //! Script bindings of the synthetic multi-camera sequences: `track::make_sequence`.
 
-use std::path::Path;
-
 use rhai::{Dynamic, Map, FLOAT, INT};
 
 use super::convert::{rt_err, RResult};
+use super::paths::resolve;
 use super::{function, modules::ApiBuilder};
 use crate::tracking::sequence::{make_sequence, SequenceOptions, SequenceSummary};
 
@@ -105,9 +104,9 @@ fn options(m: &Map) -> RResult<SequenceOptions> {
                     .into_string()
                     .map_err(|t| rt_err(format!("`{k}` must be a folder path, got {t}")))?;
                 if k == "backgrounds" {
-                    o.backgrounds = s.into();
+                    o.backgrounds = resolve(&s);
                 } else {
-                    o.makehuman = s.into();
+                    o.makehuman = resolve(&s);
                 }
             }
             other => {
@@ -139,7 +138,7 @@ fn summary_map(s: &SequenceSummary) -> Map {
 }
 
 fn run(motion: &str, out: &str, o: &SequenceOptions) -> RResult<Map> {
-    let s = make_sequence(Path::new(motion), Path::new(out), o).map_err(rt_err)?;
+    let s = make_sequence(&resolve(motion), &resolve(out), o).map_err(rt_err)?;
     Ok(summary_map(&s))
 }
 
