@@ -46,10 +46,7 @@ fn save_body_obj(sim: &Simulation, b: INT, path: &str, frame: ExportFrame) -> RR
     let (lo, hi) = crate::geometry::mesh::bounds(&sim.state.x);
     let (p, t) = crate::contact::tessellate::body_mesh(body, &lo, &hi);
     let path = resolve(path);
-    if let Some(d) = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-    {
+    if let Some(d) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(d).map_err(|e| rt_err(format!("{}: {e}", d.display())))?;
     }
     crate::geometry::write_obj(&path, &p, &t, None, frame)?;
