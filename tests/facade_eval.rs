@@ -131,5 +131,15 @@ fn eval_script_prints_the_summary_line_and_writes_its_tables() {
     // an unknown method is a script error at its line
     let bad = run(&["method=mueller"]);
     assert!(!bad.status.success());
-    assert!(String::from_utf8_lossy(&bad.stderr).contains("facades_eval.rhai:15"));
+    let script = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scripts/facades_eval.rhai"
+    ))
+    .unwrap();
+    let line = 1 + script
+        .lines()
+        .position(|l| l.contains("throw `unknown method"))
+        .unwrap();
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(err.contains(&format!("facades_eval.rhai:{line}")), "{err}");
 }
