@@ -17,6 +17,7 @@ pub mod face;
 pub mod garment;
 pub mod geometry;
 pub mod kes;
+pub mod limits;
 pub mod render;
 pub mod scenes;
 #[cfg(feature = "scripting")]

@@ -27,6 +27,10 @@ enum Command {
         /// Defines a script constant before running: `--set key=value` (int, float, bool or string).
         #[arg(long = "set", value_name = "KEY=VALUE", value_parser = parse_set)]
         sets: Vec<(String, String)>,
+        /// Raises or lowers a stated input limit: `--limit max_particles=10000000` (names and
+        /// defaults in docs/limits.md).
+        #[arg(long = "limit", value_name = "NAME=VALUE", value_parser = parse_set)]
+        limits: Vec<(String, String)>,
     },
     /// Interactive Rhai prompt with every emilion function.
     Repl {
@@ -106,7 +110,18 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
 fn scripting(cmd: Command) -> anyhow::Result<ExitCode> {
     use emilion::script;
     match cmd {
-        Command::Run { file, sets } => {
+        Command::Run { file, sets, limits } => {
+            let mut l = emilion::limits::get();
+            for (k, v) in &limits {
+                let n: u64 = v
+                    .trim()
+                    .replace('_', "")
+                    .parse()
+                    .map_err(|_| anyhow::anyhow!("--limit {k}: `{v}` is not a whole number"))?;
+                l.set_named(k, n)
+                    .map_err(|e| anyhow::anyhow!("--limit: {e}"))?;
+            }
+            emilion::limits::set(l);
             if let Err(e) = script::run_file(&file, &sets) {
                 eprintln!("{e}");
                 return Ok(ExitCode::FAILURE);
