@@ -63,7 +63,7 @@ impl BodyError {
 
 /// Reads a whole text file, naming it in the error.
 pub(crate) fn read_text(path: &std::path::Path) -> Result<String, BodyError> {
-    std::fs::read_to_string(path).map_err(|source| BodyError::Io {
+    crate::limits::read_to_string(path).map_err(|source| BodyError::Io {
         path: path.to_path_buf(),
         source,
     })

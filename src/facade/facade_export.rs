@@ -7,7 +7,6 @@
 //! the file.
 
 use std::fmt::Write as _;
-use std::io::Cursor;
 use std::path::{Component, Path};
 
 use super::error::FacadeError;
@@ -221,22 +220,17 @@ pub fn write_glb_textured(
     write_glb_mesh(path, &glb).map_err(|e| geometry_err(path, e))
 }
 
-/// The bytes of a PNG file, checked to be one (signature and header decode).
+/// The bytes of a PNG file, checked to be one (signature and header decode) of at most
+/// `max_pixels`, read within `max_file_bytes`.
 fn read_png(path: &Path) -> Result<Vec<u8>, FacadeError> {
-    let bytes = std::fs::read(path).map_err(|e| file_err(path, e.to_string()))?;
-    let reader = image::ImageReader::new(Cursor::new(&bytes))
-        .with_guessed_format()
-        .map_err(|e| file_err(path, e.to_string()))?;
-    if reader.format() != Some(image::ImageFormat::Png) {
+    let (format, _, _) = crate::geometry::image::check_image_file(path)?;
+    if format != image::ImageFormat::Png {
         return Err(file_err(
             path,
             "not a PNG image (glTF textures here are PNG)".into(),
         ));
     }
-    reader
-        .into_dimensions()
-        .map_err(|e| file_err(path, format!("unreadable PNG: {e}")))?;
-    Ok(bytes)
+    crate::limits::read(path).map_err(|e| file_err(path, e.to_string()))
 }
 
 /// `target` relative to the folder `dir`, with `/` separators (as MTL files expect); the

@@ -217,8 +217,8 @@ impl FacadeMesh {
 /// Builds the facade slab of `leaves` (a partition of the facade rectangle, as
 /// [`Grammar::derive`](super::grammar::Grammar::derive) returns). Errors: invalid parameters,
 /// no leaves, non-finite or inverted rectangles, a source outside the texture, leaves that
-/// overlap or leave a gap, or two recesses meeting only at a corner where the solid would
-/// pinch to a line (not a manifold).
+/// overlap or leave a gap, two recesses meeting only at a corner where the solid would
+/// pinch to a line (not a manifold), or a front grid of more cells than `max_elements`.
 pub fn build(leaves: &[Leaf], params: &MeshParams) -> Result<FacadeMesh, String> {
     params.check()?;
     if leaves.is_empty() {
@@ -263,6 +263,15 @@ pub fn build(leaves: &[Leaf], params: &MeshParams) -> Result<FacadeMesh, String>
     let xs = merged(leaves.iter().flat_map(|l| [l.scope.x0, l.scope.x1]), tol);
     let ys = merged(leaves.iter().flat_map(|l| [l.scope.y0, l.scope.y1]), tol);
     let (nx, ny) = (xs.len() - 1, ys.len() - 1);
+    // the grid's cells are counted against max_elements before they are allocated
+    let max = crate::limits::get().max_elements;
+    crate::limits::check_count(
+        &format!("facade mesh: the front's grid of {nx} × {ny} cells"),
+        (nx as u64).saturating_mul(ny as u64),
+        "max_elements",
+        max,
+    )
+    .map_err(|e| e.to_string())?;
 
     // Which leaf owns each grid cell.
     let mut owner = vec![usize::MAX; nx * ny];

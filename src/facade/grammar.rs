@@ -10,9 +10,9 @@
 //! ([`Grammar::parse`]), so the file alone regenerates the facade.
 
 use std::collections::BTreeMap;
-use std::fmt::Write;
 
 use super::labels::Class;
+use super::rule_file::check_shapes;
 
 /// A rectangle in facade units (pixels of the rectified photo at the parse's own size),
 /// y down: `[x0, x1) × [y0, y1)`.
@@ -70,7 +70,7 @@ pub enum Dir {
 }
 
 impl Dir {
-    fn name(self) -> &'static str {
+    pub(super) fn name(self) -> &'static str {
         match self {
             Dir::X => "x",
             Dir::Y => "y",
@@ -144,18 +144,26 @@ pub struct Grammar {
     pub size: (f64, f64),
 }
 
+/// A derivation in progress: the elements leaves index, the most shapes it may make
+/// (`max_elements`), and the shapes made.
+struct Derivation {
+    elements: Vec<String>,
+    max: u64,
+    out: Vec<Leaf>,
+}
+
 /// Deepest derivation: a rule that reaches itself is an error, not a stack overflow.
 const MAX_DEPTH: usize = 64;
 
 impl Grammar {
     /// Derives the facade at `width` × `height`: the terminal shapes, in derivation order.
-    /// Errors name the rule: an unknown rule, a cycle, a non-positive size, or fixed parts
-    /// that do not fit their scope.
+    /// Errors name the rule: an unknown rule, a cycle, a non-positive size, fixed parts
+    /// that do not fit their scope, or more shapes than the `max_elements` limit (counted
+    /// before a repeat makes its tiles).
     pub fn derive(&self, width: f64, height: f64) -> Result<Vec<Leaf>, String> {
         if !(width > 0.0 && height > 0.0 && width.is_finite() && height.is_finite()) {
             return Err(format!("facade size {width} × {height} must be positive"));
         }
-        let mut out = Vec::new();
         let scope = Scope {
             x0: 0.0,
             y0: 0.0,
@@ -168,9 +176,13 @@ impl Grammar {
             x1: self.size.0,
             y1: self.size.1,
         };
-        let elements = self.elements();
-        self.expand(&self.axiom, scope, source, 0, &elements, &mut out)?;
-        Ok(out)
+        let mut d = Derivation {
+            elements: self.elements(),
+            max: crate::limits::get().max_elements,
+            out: Vec::new(),
+        };
+        self.expand(&self.axiom, scope, source, 0, &mut d)?;
+        Ok(d.out)
     }
 
     /// The distinct elements the rules insert, sorted by name: what [`Leaf::element`] indexes.
@@ -259,8 +271,7 @@ impl Grammar {
         scope: Scope,
         source: Scope,
         depth: usize,
-        elements: &[String],
-        out: &mut Vec<Leaf>,
+        d: &mut Derivation,
     ) -> Result<(), String> {
         if depth > MAX_DEPTH {
             return Err(format!(
@@ -271,18 +282,21 @@ impl Grammar {
             .rules
             .get(name)
             .ok_or_else(|| format!("unknown rule {name}"))?;
+        if matches!(body, Body::Leaf(_) | Body::Insert { .. }) {
+            check_shapes(name, d.out.len(), 1.0, d.max)?;
+        }
         match body {
-            Body::Leaf(class) => out.push(Leaf {
+            Body::Leaf(class) => d.out.push(Leaf {
                 scope,
                 class: *class,
                 source,
                 element: None,
             }),
-            Body::Insert { class, element } => out.push(Leaf {
+            Body::Insert { class, element } => d.out.push(Leaf {
                 scope,
                 class: *class,
                 source,
-                element: elements.binary_search(element).ok(),
+                element: d.elements.binary_search(element).ok(),
             }),
             Body::Split { dir, parts } => {
                 let sizes: Vec<Size> = parts.iter().map(|p| p.0).collect();
@@ -298,8 +312,7 @@ impl Grammar {
                         scope.with(*dir, cuts[k], cuts[k + 1]),
                         source.with(*dir, scuts[k], scuts[k + 1]),
                         depth + 1,
-                        elements,
-                        out,
+                        d,
                     )?;
                 }
             }
@@ -309,6 +322,8 @@ impl Grammar {
                 }
                 let (a, b) = scope.along(*dir);
                 let (sa, sb) = source.along(*dir);
+                // each tile makes one shape at least: count them before making any
+                check_shapes(name, d.out.len(), ((b - a) / size).round(), d.max)?;
                 let n = repeat_count(b - a, *size);
                 let ns = repeat_count(sb - sa, *size);
                 for k in 0..n {
@@ -322,8 +337,7 @@ impl Grammar {
                         scope.with(*dir, a + k as f64 * step, a + (k + 1) as f64 * step),
                         source.with(*dir, sa + ks as f64 * sstep, sa + (ks + 1) as f64 * sstep),
                         depth + 1,
-                        elements,
-                        out,
+                        d,
                     )?;
                 }
             }
@@ -331,190 +345,6 @@ impl Grammar {
         Ok(())
     }
 
-    /// The rule file: one rule per line, `Name --> split(y) { 12: A | ~30: B }`,
-    /// `Name --> repeat(x, 43.5) { Tile }`, `Name --> window`,
-    /// `Name --> insert(window, window_cross)`; the axiom first, with the
-    /// parsed size in a header comment.
-    pub fn to_text(&self) -> String {
-        let mut s = String::new();
-        let _ = writeln!(
-            s,
-            "// facade grammar (CGA-like): fixed sizes in facade units, ~w a floating weight\n// axiom {} size {} {}",
-            self.axiom,
-            fmt_num(self.size.0),
-            fmt_num(self.size.1)
-        );
-        let mut names: Vec<&String> = self.rules.keys().collect();
-        names.sort_by_key(|n| (*n != &self.axiom, n.as_str()));
-        for name in names {
-            let _ = write!(s, "{name} --> ");
-            match &self.rules[name] {
-                Body::Leaf(c) => {
-                    let _ = writeln!(s, "{}", c.name());
-                }
-                Body::Insert { class, element } => {
-                    let _ = writeln!(s, "insert({}, {element})", class.name());
-                }
-                Body::Repeat { dir, size, rule } => {
-                    let _ = writeln!(s, "repeat({}, {}) {{ {rule} }}", dir.name(), fmt_num(*size));
-                }
-                Body::Split { dir, parts } => {
-                    let p: Vec<String> = parts
-                        .iter()
-                        .map(|(sz, r)| match sz {
-                            Size::Fixed(v) => format!("{}: {r}", fmt_num(*v)),
-                            Size::Floating(v) => format!("~{}: {r}", fmt_num(*v)),
-                        })
-                        .collect();
-                    let _ = writeln!(s, "split({}) {{ {} }}", dir.name(), p.join(" | "));
-                }
-            }
-        }
-        s
-    }
-
-    /// Reads a rule file written by [`Grammar::to_text`] (or by hand in the same syntax).
-    /// Errors give the line number and what was expected.
-    pub fn parse(text: &str) -> Result<Grammar, String> {
-        let mut rules = BTreeMap::new();
-        let (mut axiom, mut size) = (None, None);
-        for (ln, raw) in text.lines().enumerate() {
-            let line = raw.trim();
-            let err = |m: &str| format!("line {}: {m}: `{line}`", ln + 1);
-            if let Some(c) = line.strip_prefix("//") {
-                let w: Vec<&str> = c.split_whitespace().collect();
-                if w.len() == 5 && w[0] == "axiom" && w[2] == "size" {
-                    axiom = Some(w[1].to_string());
-                    let (a, b) = (w[3].parse::<f64>(), w[4].parse::<f64>());
-                    match (a, b) {
-                        (Ok(a), Ok(b)) => size = Some((a, b)),
-                        _ => return Err(err("the axiom's size is not two numbers")),
-                    }
-                }
-                continue;
-            }
-            if line.is_empty() {
-                continue;
-            }
-            let (name, rhs) = line
-                .split_once("-->")
-                .ok_or_else(|| err("expected `Name --> body`"))?;
-            let name = name.trim();
-            if name.is_empty() || !name.chars().all(|c| c.is_alphanumeric() || c == '_') {
-                return Err(err("a rule name is letters, digits and _"));
-            }
-            let rhs = rhs.trim();
-            let body = if let Some(class) = Class::from_name(rhs) {
-                Body::Leaf(class)
-            } else if let Some(args) = rhs
-                .strip_prefix("insert(")
-                .and_then(|a| a.strip_suffix(')'))
-            {
-                let (c, e) = args
-                    .split_once(',')
-                    .ok_or_else(|| err("insert takes (class, element)"))?;
-                let class = Class::from_name(c.trim())
-                    .ok_or_else(|| err("insert's class is window, wall, door, balcony, …"))?;
-                let element = e.trim();
-                if element.is_empty() || !element.chars().all(|c| c.is_alphanumeric() || c == '_') {
-                    return Err(err("an element name is letters, digits and _"));
-                }
-                Body::Insert {
-                    class,
-                    element: element.to_string(),
-                }
-            } else {
-                let (head, inner) = rhs
-                    .split_once('{')
-                    .and_then(|(h, r)| r.trim_end().strip_suffix('}').map(|i| (h.trim(), i)))
-                    .ok_or_else(|| {
-                        err("expected a class name, split(..) { .. } or repeat(..) { .. }")
-                    })?;
-                let args = head
-                    .split_once('(')
-                    .and_then(|(op, a)| a.strip_suffix(')').map(|a| (op.trim(), a)))
-                    .ok_or_else(|| err("expected split(dir) or repeat(dir, size)"))?;
-                let dir_of = |s: &str| match s.trim() {
-                    "x" => Ok(Dir::X),
-                    "y" => Ok(Dir::Y),
-                    _ => Err(err("direction must be x or y")),
-                };
-                match args.0 {
-                    "split" => {
-                        let dir = dir_of(args.1)?;
-                        let mut parts = Vec::new();
-                        for p in inner.split('|') {
-                            let (sz, r) = p
-                                .split_once(':')
-                                .ok_or_else(|| err("a split part is `size: Rule`"))?;
-                            let sz = sz.trim();
-                            let size = match sz.strip_prefix('~') {
-                                Some(w) => Size::Floating(
-                                    w.parse().map_err(|_| err("bad floating weight"))?,
-                                ),
-                                None => Size::Fixed(sz.parse().map_err(|_| err("bad size"))?),
-                            };
-                            parts.push((size, r.trim().to_string()));
-                        }
-                        Body::Split { dir, parts }
-                    }
-                    "repeat" => {
-                        let (d, s) = args
-                            .1
-                            .split_once(',')
-                            .ok_or_else(|| err("repeat takes (dir, size)"))?;
-                        Body::Repeat {
-                            dir: dir_of(d)?,
-                            size: s.trim().parse().map_err(|_| err("bad repeat size"))?,
-                            rule: inner.trim().to_string(),
-                        }
-                    }
-                    _ => return Err(err("unknown operation (split, repeat)")),
-                }
-            };
-            if rules.insert(name.to_string(), body).is_some() {
-                return Err(err("rule defined twice"));
-            }
-        }
-        let axiom = axiom.ok_or("missing `// axiom Name size W H` header")?;
-        let size = size.ok_or("missing the axiom's size")?;
-        let g = Grammar { rules, axiom, size };
-        g.check()?;
-        Ok(g)
-    }
-
-    /// Every referenced rule exists and every size is finite and non-negative.
-    pub fn check(&self) -> Result<(), String> {
-        if !self.rules.contains_key(&self.axiom) {
-            return Err(format!("the axiom {} has no rule", self.axiom));
-        }
-        for (name, body) in &self.rules {
-            let refs: Vec<&String> = match body {
-                Body::Leaf(_) | Body::Insert { .. } => Vec::new(),
-                Body::Repeat { rule, size, .. } => {
-                    if !(*size > 0.0 && size.is_finite()) {
-                        return Err(format!("rule {name}: repeat size {size} must be positive"));
-                    }
-                    vec![rule]
-                }
-                Body::Split { parts, .. } => {
-                    for (s, _) in parts {
-                        let v = match s {
-                            Size::Fixed(v) | Size::Floating(v) => *v,
-                        };
-                        if !(v >= 0.0 && v.is_finite()) {
-                            return Err(format!("rule {name}: size {v} must be ≥ 0"));
-                        }
-                    }
-                    parts.iter().map(|p| &p.1).collect()
-                }
-            };
-            if let Some(r) = refs.iter().find(|r| !self.rules.contains_key(r.as_str())) {
-                return Err(format!("rule {name} refers to unknown rule {r}"));
-            }
-        }
-        Ok(())
-    }
 }
 
 /// Tiles of nominal `size` that fill `extent`: the nearest whole number, at least one.
@@ -561,12 +391,6 @@ pub fn split_positions(sizes: &[Size], a: f64, b: f64) -> Result<Vec<f64>, Strin
     // the last cut is exactly the scope's end, whatever the rounding
     *cuts.last_mut().expect("cuts") = b;
     Ok(cuts)
-}
-
-/// Shortest decimal that reads back to the same f64 (Rust's `Display`), but integers without
-/// a fraction.
-fn fmt_num(v: f64) -> String {
-    format!("{v}")
 }
 
 #[cfg(test)]

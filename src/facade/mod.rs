@@ -34,6 +34,7 @@ pub mod rect;
 pub mod refinement;
 pub mod repetition;
 pub mod report;
+pub mod rule_file;
 pub mod score;
 pub mod segments;
 pub mod structure;

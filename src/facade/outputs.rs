@@ -18,6 +18,7 @@ use super::grammar::Grammar;
 use super::labels::{Class, LabelMap};
 use super::overlay;
 use super::rasterize::rasterize;
+use super::rule_file::check_extent;
 use super::segments;
 use crate::geometry::LookAtCamera;
 use crate::geometry::Vec3;
@@ -192,12 +193,20 @@ pub fn write_generated(
     let library =
         Library::builtin().map_err(|e| file_err(Path::new("assets/facade_elements"), e))?;
     let names = grammar.elements();
-    let sizes = opts
+    let sizes: Vec<_> = opts
         .widths
         .iter()
-        .map(|&f| (format!("w{f}"), f, 1.0))
-        .chain(opts.heights.iter().map(|&f| (format!("h{f}"), 1.0, f)));
-    for (tag, fx, fy) in sizes {
+        .map(|&f| (format!("w{f}"), f, 1.0, "widths"))
+        .chain(opts.heights.iter().map(|&f| (format!("h{f}"), 1.0, f, "heights")))
+        .collect();
+    // every size within bounds before anything is derived or written
+    for (_, fx, fy, what) in &sizes {
+        let (wm, hm) = (w * fx * params.scale, h * fy * params.scale);
+        let factor = fx * fy;
+        check_extent(&format!("`{what}` factor {factor}"), wm, hm)
+            .map_err(|e| file_err(dir, e))?;
+    }
+    for (tag, fx, fy, _) in sizes {
         let obj = dir.join(format!("{stem}_{tag}.obj"));
         let leaves = grammar
             .derive(w * fx, h * fy)

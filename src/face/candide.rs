@@ -260,7 +260,7 @@ fn unit_from_comments(comments: &[&str], displacements: Vec<(usize, Vec3)>) -> C
 impl Candide {
     /// Reads a `.wfm` file. Errors name the file and the line.
     pub fn load(path: &Path) -> Result<Candide, FaceError> {
-        let bytes = std::fs::read(path).map_err(|e| FaceError::io(path, e))?;
+        let bytes = crate::limits::read(path).map_err(|e| FaceError::io(path, e))?;
         // The upstream file has a stray non-UTF-8 byte in a comment: read lossily.
         Candide::parse(&String::from_utf8_lossy(&bytes), path)
     }

@@ -159,7 +159,7 @@ pub fn inter_ocular_distance(points: &[[f64; 2]]) -> f64 {
 /// Reads a `.pts` file of exactly 68 points. Errors name the file and line: missing header or
 /// braces, wrong count, malformed or non-finite numbers.
 pub fn read_pts(path: &Path) -> Result<Vec<[f64; 2]>, FaceError> {
-    let text = std::fs::read_to_string(path).map_err(|e| FaceError::io(path, e))?;
+    let text = crate::limits::read_to_string(path).map_err(|e| FaceError::io(path, e))?;
     parse_pts(&text, path)
 }
 

@@ -46,7 +46,7 @@ impl SequenceInfo {
 
     /// Reads `sequence.json`; errors name the file.
     pub fn load(path: &Path) -> Result<SequenceInfo, FaceError> {
-        let text = std::fs::read_to_string(path).map_err(|e| FaceError::io(path, e))?;
+        let text = crate::limits::read_to_string(path).map_err(|e| FaceError::io(path, e))?;
         let info: SequenceInfo = serde_json::from_str(&text).map_err(|e| FaceError::Parse {
             path: path.to_path_buf(),
             line: e.line(),
@@ -121,7 +121,7 @@ pub fn write_pose_csv(path: &Path, faps: &[u8], rows: &[PoseRow]) -> Result<(), 
 /// Reads a pose CSV; returns the FAP numbers of its columns and the rows. Errors name the
 /// file and line.
 pub fn read_pose_csv(path: &Path) -> Result<(Vec<u8>, Vec<PoseRow>), FaceError> {
-    let text = std::fs::read_to_string(path).map_err(|e| FaceError::io(path, e))?;
+    let text = crate::limits::read_to_string(path).map_err(|e| FaceError::io(path, e))?;
     let err = |line: usize, message: String| FaceError::Parse {
         path: path.to_path_buf(),
         line,

@@ -67,7 +67,7 @@ pub fn write_pc2(
 /// counts, or a length that does not match the header (no allocation beyond the file's size).
 pub fn read_pc2(path: &Path) -> Result<PointCache, GeometryError> {
     let invalid = |m: String| GeometryError::Invalid(format!("{}: {m}", path.display()));
-    let bytes = std::fs::read(path).map_err(|e| invalid(e.to_string()))?;
+    let bytes = crate::limits::read(path).map_err(|e| invalid(e.to_string()))?;
     if bytes.len() < HEADER || &bytes[..12] != SIGNATURE {
         return Err(invalid(
             "not a PC2 point cache (no POINTCACHE2 header)".into(),

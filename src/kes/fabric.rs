@@ -405,7 +405,7 @@ pub fn parse_fabric(text: &str, file: &str) -> Result<FabricSpec, KesError> {
 /// Reads a fabric file.
 pub fn read_fabric(path: &Path) -> Result<FabricSpec, KesError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| KesError::Io {
+    let text = crate::limits::read_to_string(path).map_err(|e| KesError::Io {
         file: file.clone(),
         message: e.to_string(),
     })?;

@@ -113,7 +113,7 @@ fn lerp(a: f64, b: f64, t: f64) -> f64 {
 /// Converts one ARCSim/Wang material file.
 pub fn import_wang(path: &Path) -> Result<FabricSpec, KesError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| KesError::Io {
+    let text = crate::limits::read_to_string(path).map_err(|e| KesError::Io {
         file: file.clone(),
         message: e.to_string(),
     })?;

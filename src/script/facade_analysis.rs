@@ -12,10 +12,11 @@ use super::paths::{resolve, resolve_opt};
 use super::{function, getter, modules::ApiBuilder, register};
 use crate::facade::analysis::{analyze, Analysis, Options, Rectify};
 use crate::facade::facade_mesh::MeshParams;
-use crate::facade::grammar::{Body, Grammar};
+use crate::facade::grammar::Body;
 use crate::facade::homography::warp_labels;
 use crate::facade::outputs::{write_generated, write_outputs, OutputOptions};
 use crate::facade::rasterize::{rasterize, round_trip};
+use crate::facade::rule_file::read_rules;
 use crate::facade::{Class, FacadeParse};
 
 /// An analysed photo as a script handle (shared, never copied).
@@ -140,10 +141,7 @@ fn from_rules(rules: &str, out: &str, stem: &str, m: &Map) -> RResult<Array> {
             }
         }
     }
-    let rules = resolve(rules);
-    let name = rules.display();
-    let text = std::fs::read_to_string(&rules).map_err(|e| rt_err(format!("{name}: {e}")))?;
-    let grammar = Grammar::parse(&text).map_err(|e| rt_err(format!("{name}: {e}")))?;
+    let grammar = read_rules(&resolve(rules)).map_err(|e| rt_err(e.to_string()))?;
     let params = MeshParams::new(scale, grammar.size);
     let files = write_generated(
         &grammar,

@@ -175,7 +175,7 @@ impl Sequence {
                 what: "sequence description (sequence.json)".into(),
             });
         }
-        let text = std::fs::read_to_string(&meta_path).map_err(io_err(&meta_path))?;
+        let text = crate::limits::read_to_string(&meta_path).map_err(io_err(&meta_path))?;
         let json_err = |message: String| SequenceError::Json {
             path: meta_path.clone(),
             message,
@@ -396,7 +396,7 @@ pub fn write_joints_csv(
 /// `frame`, `time` and the three coordinates of every tracking joint, in any order; frames
 /// must count up from 0 by one.
 pub fn read_joints_csv(path: &Path) -> Result<Vec<(usize, f64, JointFrame)>, SequenceError> {
-    let text = std::fs::read_to_string(path).map_err(io_err(path))?;
+    let text = crate::limits::read_to_string(path).map_err(io_err(path))?;
     let csv_err = |line: usize, message: String| SequenceError::Csv {
         path: path.to_path_buf(),
         line,

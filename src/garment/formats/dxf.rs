@@ -88,7 +88,7 @@ const ALLOWED: &[&str] = &[
 
 /// Reads a DXF-AAMA pattern file.
 pub fn read_pattern_dxf(path: &Path) -> Result<Pattern, PatternError> {
-    let data = std::fs::read(path).map_err(|source| PatternError::Io {
+    let data = crate::limits::read(path).map_err(|source| PatternError::Io {
         path: path.to_path_buf(),
         source,
     })?;

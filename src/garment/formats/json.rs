@@ -56,7 +56,7 @@ use crate::garment::pattern::Pattern;
 /// validates the pattern.
 pub fn read_pattern_json(path: impl AsRef<Path>) -> Result<Pattern, PatternError> {
     let path = path.as_ref();
-    let text = std::fs::read_to_string(path).map_err(|source| PatternError::Io {
+    let text = crate::limits::read_to_string(path).map_err(|source| PatternError::Io {
         path: path.to_path_buf(),
         source,
     })?;

@@ -96,7 +96,7 @@ fn present<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Option<String>>, D:
 /// table and the SVG.
 pub fn read_garment(path: impl AsRef<Path>) -> Result<Pattern, PatternError> {
     let path = path.as_ref();
-    let text = std::fs::read_to_string(path).map_err(|source| PatternError::Io {
+    let text = crate::limits::read_to_string(path).map_err(|source| PatternError::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -106,7 +106,7 @@ pub fn read_garment(path: impl AsRef<Path>) -> Result<Pattern, PatternError> {
         metres_per_unit: table.svg_metres_per_unit,
         ..SvgOptions::default()
     };
-    let svg_text = std::fs::read_to_string(&svg_path).map_err(|source| PatternError::Io {
+    let svg_text = crate::limits::read_to_string(&svg_path).map_err(|source| PatternError::Io {
         path: svg_path.clone(),
         source,
     })?;

@@ -332,7 +332,7 @@ impl Camera {
     /// Reads and validates a camera file; errors name the file and the field.
     pub fn load(path: impl AsRef<Path>) -> Result<Camera, CameraError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| CameraError::Io {
+        let text = crate::limits::read_to_string(path).map_err(|source| CameraError::Io {
             path: path.to_path_buf(),
             source,
         })?;

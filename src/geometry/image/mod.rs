@@ -18,5 +18,6 @@ pub use components::{components, Component, Connectivity};
 pub use gradient_image::GradientImage;
 pub use gray::{luma, read_rgb, Gray};
 pub use photo_formats::{
-    is_photo, photo_files, photo_with_stem, photo_with_stem_or, read_photo, PHOTO_EXTENSIONS,
+    check_image_file, check_pixels, is_photo, photo_files, photo_with_stem, photo_with_stem_or,
+    read_photo, PHOTO_EXTENSIONS,
 };

@@ -4,7 +4,9 @@
 //! ([`photo_with_stem`]) and reading one as 8-bit RGB with an error that names the file and
 //! the formats it could have been ([`read_photo`]). Every place that lists or reads photos
 //! (face photos with landmarks, facade photos, tracking frames and backgrounds) goes through
-//! here, so they all accept the same formats and fail the same way.
+//! here, so they all accept the same formats and fail the same way. The size an image
+//! declares in its header is checked against the `max_pixels` limit before it is decoded
+//! ([`check_image_file`]), so a small file that decodes to gigabytes is refused.
 
 use std::io;
 use std::path::{Path, PathBuf};
@@ -12,6 +14,7 @@ use std::path::{Path, PathBuf};
 use image::RgbImage;
 
 use crate::geometry::GeometryError;
+use crate::limits::{self, LimitError};
 
 /// Extensions (lower case, no dot) of the photos the engine lists and reads: PNG, JPEG, the
 /// PNM family (PPM, PGM, PBM, PAM), TIFF, BMP, WebP and TGA. Case does not matter in a file
@@ -61,35 +64,86 @@ pub fn photo_with_stem_or(dir: &Path, stem: &str, default_ext: &str) -> PathBuf 
     photo_with_stem(dir, stem).unwrap_or_else(|| dir.join(format!("{stem}.{default_ext}")))
 }
 
-/// Reads a photo in any of the [`PHOTO_EXTENSIONS`] formats as 8-bit RGB (grey becomes three
-/// equal channels, alpha is dropped, 16-bit is scaled to 8). The format is taken from the
-/// file's content, not its name. An error names the file: missing or unreadable, or "cannot
-/// be decoded as an image" with the formats that can and the decoder's reason.
-pub fn read_photo(path: &Path) -> Result<RgbImage, GeometryError> {
+/// Checks an image of `width` × `height` pixels against the `max_pixels` limit (and that it
+/// is not empty); `what` names it (a file, a parameter) in the error.
+pub fn check_pixels(what: &str, width: u64, height: u64) -> Result<(), LimitError> {
+    let max = limits::get().max_pixels;
+    let n = width.saturating_mul(height);
+    if n > max {
+        return Err(LimitError {
+            what: format!("{what} ({width} × {height})"),
+            value: format!("{n} pixels"),
+            limit: "max_pixels",
+            max,
+        });
+    }
+    Ok(())
+}
+
+/// An image reader on `path` with its format guessed from the content; `None` format when the
+/// content is no image format the crate reads.
+fn open_image(
+    path: &Path,
+) -> Result<image::ImageReader<io::BufReader<std::fs::File>>, GeometryError> {
     let err = |message: String| GeometryError::Image {
         path: path.to_path_buf(),
         message,
     };
-    let reader = image::ImageReader::open(path)
+    limits::check_file(path).map_err(|e| err(e.to_string()))?;
+    image::ImageReader::open(path)
         .map_err(|e| err(e.to_string()))?
         .with_guessed_format()
-        .map_err(|e| err(e.to_string()))?;
-    let undecodable = |reason: String| {
-        err(format!(
+        .map_err(|e| err(e.to_string()))
+}
+
+fn undecodable(path: &Path, reason: String) -> GeometryError {
+    GeometryError::Image {
+        path: path.to_path_buf(),
+        message: format!(
             "cannot be decoded as an image (readable formats: {}): {reason}",
             photo_extensions_list()
-        ))
-    };
-    if reader.format().is_none() {
-        return Err(undecodable("unrecognised content".into()));
+        ),
     }
-    let img = reader.decode().map_err(|e| undecodable(e.to_string()))?;
+}
+
+/// The format and size (pixels) an image file declares in its header, read without decoding
+/// it, after checking the file against `max_file_bytes` and the size against `max_pixels`
+/// ([`check_pixels`]) and that it is not empty. Every image the engine decodes is checked
+/// here first; the error names the file, its size and the limit.
+pub fn check_image_file(path: &Path) -> Result<(image::ImageFormat, u32, u32), GeometryError> {
+    let reader = open_image(path)?;
+    let Some(format) = reader.format() else {
+        return Err(undecodable(path, "unrecognised content".into()));
+    };
+    let (w, h) = reader
+        .into_dimensions()
+        .map_err(|e| undecodable(path, e.to_string()))?;
+    if w == 0 || h == 0 {
+        return Err(undecodable(path, format!("empty image ({w}×{h})")));
+    }
+    check_pixels("the image", u64::from(w), u64::from(h)).map_err(|e| GeometryError::Image {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    Ok((format, w, h))
+}
+
+/// Reads a photo in any of the [`PHOTO_EXTENSIONS`] formats as 8-bit RGB (grey becomes three
+/// equal channels, alpha is dropped, 16-bit is scaled to 8). The format is taken from the
+/// file's content, not its name; the size its header declares is checked first
+/// ([`check_image_file`]: `max_pixels`). An error names the file: missing or unreadable, too
+/// large, or "cannot be decoded as an image" with the formats that can and the decoder's
+/// reason.
+pub fn read_photo(path: &Path) -> Result<RgbImage, GeometryError> {
+    check_image_file(path)?;
+    let img = open_image(path)?
+        .decode()
+        .map_err(|e| undecodable(path, e.to_string()))?;
     if img.width() == 0 || img.height() == 0 {
-        return Err(undecodable(format!(
-            "empty image ({}×{})",
-            img.width(),
-            img.height()
-        )));
+        return Err(undecodable(
+            path,
+            format!("empty image ({}×{})", img.width(), img.height()),
+        ));
     }
     Ok(img.into_rgb8())
 }

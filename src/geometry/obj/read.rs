@@ -4,7 +4,6 @@
 //! surface of a collision body ([`read_obj_surface`]), or the polygons of a file with the
 //! groups they belong to ([`obj_polygons_from_text`]).
 
-use std::fs;
 use std::path::Path;
 
 use crate::geometry::{GeometryError, TriMesh, Vec3};
@@ -51,7 +50,7 @@ pub fn read_obj(path: &Path) -> Result<TriMesh, GeometryError> {
 /// fanned; texture coordinates and normals are ignored. Errors as [`read_obj`] (file and line);
 /// the mesh's own validity (degenerate or non-manifold faces) is left to its user.
 pub fn read_obj_surface(path: &Path) -> Result<(Vec<Vec3>, Vec<[usize; 3]>), GeometryError> {
-    let text = fs::read_to_string(path).map_err(|source| GeometryError::Io {
+    let text = crate::limits::read_to_string(path).map_err(|source| GeometryError::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -82,7 +81,7 @@ fn parse_error(path: &Path, line: usize, message: String) -> GeometryError {
 
 /// Reads and parses `path` (see [`parse`]), errors naming the file and line.
 fn read_and_parse(path: &Path, need_uv: bool) -> Result<(TriMesh, Vec<usize>), GeometryError> {
-    let text = fs::read_to_string(path).map_err(|source| GeometryError::Io {
+    let text = crate::limits::read_to_string(path).map_err(|source| GeometryError::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -296,6 +295,7 @@ fn corner(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::fs;
     use crate::geometry::grid_mesh;
     use crate::geometry::obj::write_obj;
     use crate::geometry::ExportFrame;
