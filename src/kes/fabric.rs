@@ -10,6 +10,7 @@ use serde_json::{json, Map, Value};
 
 use super::error::KesError;
 use super::kes_param::KesParam;
+use super::ranges;
 use super::units::{self, Quantity};
 
 /// Format tag of fabric files.
@@ -176,6 +177,20 @@ impl Reader<'_> {
         units::to_si(value, unit, q).map_err(|e| self.err(&format!("{field}.unit"), e.to_string()))
     }
 
+    /// `si` (of quantity `q`) if its value in KES units lies in `range`.
+    fn in_range(
+        &self,
+        si: f64,
+        field: &str,
+        q: Quantity,
+        range: ranges::Range,
+    ) -> Result<f64, KesError> {
+        range
+            .check(q.kes_unit().from_si(si))
+            .map(|_| si)
+            .map_err(|m| self.err(field, m))
+    }
+
     fn non_negative(&self, v: f64, field: &str) -> Result<f64, KesError> {
         if v < 0.0 {
             Err(self.err(field, format!("must be ≥ 0, got {v}")))
@@ -311,11 +326,15 @@ pub fn parse_fabric(text: &str, file: &str) -> Result<FabricSpec, KesError> {
     if density <= 0.0 {
         return Err(r.err("weight", format!("must be > 0, got {density}")));
     }
+    r.in_range(density, "weight", Quantity::ArealWeight, ranges::WEIGHT)?;
     let thickness = match obj.get("thickness") {
-        Some(v) => Some(r.non_negative(
-            r.quantity(v, "thickness", Quantity::Thickness)?,
-            "thickness",
-        )?),
+        Some(v) => {
+            let t = r.non_negative(
+                r.quantity(v, "thickness", Quantity::Thickness)?,
+                "thickness",
+            )?;
+            Some(r.in_range(t, "thickness", Quantity::Thickness, ranges::THICKNESS)?)
+        }
         None => None,
     };
     let mut dirs = [KesValues::default(), KesValues::default()];
@@ -336,23 +355,9 @@ pub fn parse_fabric(text: &str, file: &str) -> Result<FabricSpec, KesError> {
                 let field = format!("kes.{dname}.{pname}");
                 let p = KesParam::from_name(pname)
                     .ok_or_else(|| r.err(&field, "unknown KES parameter"))?;
-                let v = r.non_negative(r.quantity(pv, &field, units::quantity_of(p))?, &field)?;
-                if let Some(u) = p.upper() {
-                    if v > u {
-                        return Err(r.err(
-                            &field,
-                            format!(
-                                "must be ≤ {}",
-                                if u == 1.0 && units::quantity_of(p) == Quantity::Fraction {
-                                    "100 %"
-                                } else {
-                                    "1"
-                                }
-                            ),
-                        ));
-                    }
-                }
-                dirs[d].set(p, v);
+                let q = units::quantity_of(p);
+                let v = r.non_negative(r.quantity(pv, &field, q)?, &field)?;
+                dirs[d].set(p, r.in_range(v, &field, q, ranges::param_range(p))?);
             }
         }
     }
@@ -382,6 +387,12 @@ pub fn parse_fabric(text: &str, file: &str) -> Result<FabricSpec, KesError> {
                     if tensile_fm <= 0.0 {
                         return Err(r.err("protocol.tensile_fm", "must be > 0"));
                     }
+                    r.in_range(
+                        tensile_fm,
+                        "protocol.tensile_fm",
+                        Quantity::ForcePerWidth,
+                        ranges::TENSILE_FM,
+                    )?;
                 }
                 _ => return Err(r.err(&format!("protocol.{k}"), "unknown field")),
             }

@@ -1,6 +1,6 @@
 //! The seventeen KES-F parameters ([`KesParam`]): tensile (EMT, LT, WT, RT), shear (G, 2HG,
 //! 2HG5), bending (B, 2HB), compression (LC, WC, RC, T0, TM) and surface (MIU, MMD, SMD),
-//! with the names KES writes and the bounds of their SI values.
+//! with the names KES writes (their ranges in real fabrics: [`super::ranges`]).
 
 /// The KES-F parameters (per direction).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -90,14 +90,5 @@ impl KesParam {
     /// The parameter named `name`.
     pub fn from_name(name: &str) -> Option<KesParam> {
         ALL_PARAMS.into_iter().find(|p| p.name() == name)
-    }
-
-    /// Upper bound of the SI value, when the quantity has one (ratios ≤ 1, percentages ≤ 100 %).
-    pub(super) fn upper(&self) -> Option<f64> {
-        use KesParam::*;
-        match self {
-            Lt | Lc | Rt | Rc => Some(1.0),
-            _ => None,
-        }
     }
 }

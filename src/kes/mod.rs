@@ -13,6 +13,7 @@ pub mod kes_param;
 pub mod lab;
 pub mod parameters;
 pub(crate) mod quasi_static;
+pub mod ranges;
 pub mod rig;
 pub mod rig_parameters;
 pub mod units;

@@ -98,7 +98,8 @@ pub fn render(meshes: &[RenderMesh], camera: &LookAtCamera) -> RgbImage {
 
 /// Renders `meshes` (see [`render`]) and writes the picture as PNG to `path`, creating parent
 /// folders; written to a temporary file then renamed. Fails, naming the file, when the
-/// camera's width or height is outside 1..=[`MAX_SIZE`], the camera is unusable (non-finite
+/// camera's width or height is outside 1..=[`MAX_SIZE`], its pixels are more than the
+/// `max_pixels` limit, the camera is unusable (non-finite
 /// values, eye on the target, field of view outside (0°, 180°)), or on an I/O error.
 pub fn render_png(
     path: &Path,
@@ -113,6 +114,8 @@ pub fn render_png(
             camera.width, camera.height
         )));
     }
+    crate::geometry::image::check_pixels("image size", camera.width.into(), camera.height.into())
+        .map_err(|e| invalid(e.to_string()))?;
     if camera.frame().is_none() {
         return Err(invalid(format!(
             "unusable camera (eye {:?}, target {:?}, fov {}°): eye must differ from target, values be finite, fov within (0, 180)",

@@ -12,6 +12,7 @@ use crate::cloth::{stats, Simulation};
 use crate::contact::recording::{CacheFormat, Recording};
 use crate::contact::tessellate::body_mesh;
 use crate::contact::SimulationContact;
+use crate::geometry::image::check_pixels;
 use crate::geometry::LookAtCamera;
 use crate::geometry::{mesh::bounds, write_glb, write_obj, ExportFrame, UpAxis};
 use crate::render::{render_png, RenderMesh};
@@ -45,13 +46,21 @@ fn camera(sim: &Simulation, m: &Map) -> RResult<LookAtCamera> {
     let size = |k: &str, d: u32| -> RResult<u32> {
         match m.get(k) {
             Some(v) => match count(v, k)? {
-                0 => Err(rt_err(format!("`{k}` must be > 0"))),
-                n => Ok(n.min(16384) as u32),
+                0 => Err(rt_err(format!("render camera `{k}` must be ≥ 1 pixel"))),
+                n => u32::try_from(n)
+                    .map_err(|_| rt_err(format!("render camera `{k}` {n} is too large"))),
             },
             None => Ok(d),
         }
     };
-    let mut cam = auto_camera(sim, size("width", 800)?, size("height", 600)?);
+    let (width, height) = (size("width", 800)?, size("height", 600)?);
+    check_pixels(
+        "render camera `width` × `height`",
+        width.into(),
+        height.into(),
+    )
+    .map_err(|e| rt_err(e.to_string()))?;
+    let mut cam = auto_camera(sim, width, height);
     if let Some(v) = m.get("eye") {
         cam.eye = super::convert::vec3(v, "eye")?.into();
     }
@@ -300,7 +309,7 @@ pub fn register(engine: &mut Engine) {
         }
     );
     register!(engine, "render", ["sim: Simulation", "path: String", "camera: Map", "()"],
-        "Renders the cloth to a PNG with a camera #{eye: [..], target: [..], up: [..], fov: degrees,\nwidth, height}; missing entries come from the auto-framing 800×600 camera.",
+        "Renders the cloth to a PNG with a camera #{eye: [..], target: [..], up: [..], fov: degrees,\nwidth, height}; missing entries come from the auto-framing 800×600 camera. Width and height are ≥ 1\nand their product at most the `max_pixels` limit (an error otherwise, never a smaller picture).",
         |h: &mut SimHandle, path: &str, m: Map| -> RResult<()> {
             let s = h.get()?;
             render(&s, path, &camera(&s, &m)?)
