@@ -111,11 +111,12 @@ pub fn write_fit_outputs(
     out: &Path,
     texture_size: usize,
 ) -> Result<FitReport, FaceError> {
-    std::fs::create_dir_all(out).map_err(|e| FaceError::io(out, e))?;
-    let mut files = Vec::new();
     let errors: Vec<f64> = (0..photos.views.len())
         .map(|v| fit.landmark_error_iod_pct(v))
         .collect();
+    check_fit(fit, &errors)?;
+    std::fs::create_dir_all(out).map_err(|e| FaceError::io(out, e))?;
+    let mut files = Vec::new();
     let mut csv = String::from("photo,landmark_err_iod_pct\n");
     for (n, e) in photos.names.iter().zip(&errors) {
         csv.push_str(&format!("{n},{e:.4}\n"));
@@ -196,6 +197,43 @@ pub fn write_fit_outputs(
         mean_abs_change: change,
         files,
     })
+}
+
+/// Largest size of an adapted face as a multiple of the generic one's (bounding-box
+/// diagonal): beyond it the adaptation has run away and the result is no face.
+pub const MAX_FACE_GROWTH: f64 = 10.0;
+
+/// Checks a finished fit before anything is written: every landmark error finite (a NaN or
+/// infinite error is a failed fit, never a result), every vertex finite and the face at most
+/// [`MAX_FACE_GROWTH`] times the generic one. Errors name the view (its landmark file).
+pub fn check_fit(fit: &FaceFit, errors: &[f64]) -> Result<(), FaceError> {
+    let name = |v: usize| fit.views.get(v).map_or_else(String::new, |v| v.name.clone());
+    if let Some(v) = errors.iter().position(|e| !e.is_finite()) {
+        return Err(FaceError::Landmarks {
+            source_name: name(v),
+            message: format!(
+                "the adaptation failed: the landmark error is {} (the landmarks cannot be fitted)",
+                errors[v]
+            ),
+        });
+    }
+    let diagonal = |ps: &[crate::geometry::Vec3]| {
+        let (lo, hi) = crate::geometry::mesh::bounds(ps);
+        (hi - lo).norm()
+    };
+    let (got, generic) = (
+        diagonal(&fit.mesh.positions),
+        diagonal(&fit.generic.positions),
+    );
+    if !(got.is_finite() && got <= MAX_FACE_GROWTH * generic) {
+        return Err(FaceError::Landmarks {
+            source_name: (0..fit.views.len()).map(name).collect::<Vec<_>>().join(", "),
+            message: format!(
+                "the adaptation failed: the adapted face spans {got:.3e} m, more than {MAX_FACE_GROWTH} × the generic face's {generic:.3} m"
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// The whole fit: photos with landmarks from `images` (and `pts_dir`), adaptation of the

@@ -156,6 +156,65 @@ pub fn inter_ocular_distance(points: &[[f64; 2]]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
 }
 
+/// Smallest inter-ocular distance (pixels) of a usable face: below it the face is a few pixels
+/// across, or its points are piled up (a file of identical points), and no adaptation is
+/// defined.
+pub const MIN_IOD_PX: f64 = 4.0;
+
+/// Smallest spread of the 68 points across their main direction, as a share of the
+/// inter-ocular distance: a real face's points spread about as far down (eyes to chin) as
+/// across (≈ 0.6 of the IOD as an RMS); points on one line (0) are no face.
+pub const MIN_SPREAD_IOD: f64 = 0.1;
+
+/// Checks that 68 landmarks can be a face: finite, the outer eye corners at least
+/// [`MIN_IOD_PX`] apart, and not all on one line (their RMS spread across their main
+/// direction at least [`MIN_SPREAD_IOD`] × the inter-ocular distance). Errors name `source`.
+pub fn check_geometry(points: &[[f64; 2]], source: &str) -> Result<(), FaceError> {
+    let err = |message: String| FaceError::Landmarks {
+        source_name: source.to_string(),
+        message,
+    };
+    if points.len() != IBUG_POINTS {
+        return Err(err(format!(
+            "expected {IBUG_POINTS} landmarks (iBUG scheme), got {}",
+            points.len()
+        )));
+    }
+    if let Some(i) = points
+        .iter()
+        .position(|p| !(p[0].is_finite() && p[1].is_finite()))
+    {
+        return Err(err(format!("landmark {i} is not finite")));
+    }
+    let iod = inter_ocular_distance(points);
+    if !(iod >= MIN_IOD_PX) {
+        return Err(err(format!(
+            "degenerate landmarks: the outer eye corners (points {IBUG_RIGHT_EYE_OUTER} and {IBUG_LEFT_EYE_OUTER}) are {iod:.3} px apart, less than {MIN_IOD_PX} px"
+        )));
+    }
+    // the smaller principal spread of the points (the square root of the covariance's
+    // smaller eigenvalue)
+    let n = points.len() as f64;
+    let (mx, my) = points
+        .iter()
+        .fold((0.0, 0.0), |(x, y), p| (x + p[0] / n, y + p[1] / n));
+    let (mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0);
+    for p in points {
+        let (dx, dy) = (p[0] - mx, p[1] - my);
+        sxx += dx * dx / n;
+        syy += dy * dy / n;
+        sxy += dx * dy / n;
+    }
+    let half = 0.5 * (sxx + syy);
+    let minor = (half - (0.25 * (sxx - syy).powi(2) + sxy * sxy).sqrt()).max(0.0).sqrt();
+    if !(minor >= MIN_SPREAD_IOD * iod) {
+        return Err(err(format!(
+            "degenerate landmarks: the points lie on a line (spread {minor:.3} px across it, less than {MIN_SPREAD_IOD} × the inter-ocular distance {iod:.1} px)"
+        )));
+    }
+    Ok(())
+}
+
 /// Reads a `.pts` file of exactly 68 points. Errors name the file and line: missing header or
 /// braces, wrong count, malformed or non-finite numbers.
 pub fn read_pts(path: &Path) -> Result<Vec<[f64; 2]>, FaceError> {

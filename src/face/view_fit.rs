@@ -80,8 +80,10 @@ impl View {
         }
     }
 
-    /// Checks the image size, the landmark count, finiteness and that every point is inside
-    /// the image (one pixel of margin). Errors name the view.
+    /// Checks the image size, the landmark count, finiteness, that every point is inside
+    /// the image (one pixel of margin) and that the points can be a face
+    /// ([`check_geometry`](super::landmarks::check_geometry): not piled up nor on a line).
+    /// Errors name the view.
     pub fn validate(&self) -> Result<(), FaceError> {
         let err = |message: String| FaceError::Landmarks {
             source_name: format!("view `{}`", self.name),
@@ -119,7 +121,7 @@ impl View {
                 p[0], p[1], self.width, self.height
             )));
         }
-        Ok(())
+        super::landmarks::check_geometry(&self.landmarks, &format!("view `{}`", self.name))
     }
 }
 
