@@ -344,7 +344,6 @@ impl Grammar {
         }
         Ok(())
     }
-
 }
 
 /// Tiles of nominal `size` that fill `extent`: the nearest whole number, at least one.

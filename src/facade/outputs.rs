@@ -197,14 +197,17 @@ pub fn write_generated(
         .widths
         .iter()
         .map(|&f| (format!("w{f}"), f, 1.0, "widths"))
-        .chain(opts.heights.iter().map(|&f| (format!("h{f}"), 1.0, f, "heights")))
+        .chain(
+            opts.heights
+                .iter()
+                .map(|&f| (format!("h{f}"), 1.0, f, "heights")),
+        )
         .collect();
     // every size within bounds before anything is derived or written
     for (_, fx, fy, what) in &sizes {
         let (wm, hm) = (w * fx * params.scale, h * fy * params.scale);
         let factor = fx * fy;
-        check_extent(&format!("`{what}` factor {factor}"), wm, hm)
-            .map_err(|e| file_err(dir, e))?;
+        check_extent(&format!("`{what}` factor {factor}"), wm, hm).map_err(|e| file_err(dir, e))?;
     }
     for (tag, fx, fy, _) in sizes {
         let obj = dir.join(format!("{stem}_{tag}.obj"));

@@ -29,9 +29,20 @@ pub fn check_number(v: f64, what: &str, positive: bool) -> Result<f64, String> {
         Ok(v)
     } else {
         Err(format!(
-            "{what} {v} is outside {}{MAX_FACADE_UNITS}] facade units (a facade of at most 1 km at 1 mm per unit)",
-            if positive { "(0, " } else { "[0, " }
+            "{what} {} is outside {}{}] facade units (a facade of at most 1 km at 1 mm per unit)",
+            shown(v),
+            if positive { "(0, " } else { "[0, " },
+            shown(MAX_FACADE_UNITS)
         ))
+    }
+}
+
+/// `v` for a message: plain for ordinary magnitudes, in exponent form for huge or tiny ones.
+fn shown(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && !(1e-4..1e6).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
     }
 }
 
@@ -57,7 +68,9 @@ pub fn check_extent(what: &str, width_m: f64, height_m: f64) -> Result<(), Strin
         Ok(())
     } else {
         Err(format!(
-            "{what}: the facade would be {width_m} × {height_m} m, outside (0, {MAX_FACADE_METRES}] m each way"
+            "{what}: the facade would be {} × {} m, outside (0, {MAX_FACADE_METRES}] m each way",
+            shown(width_m),
+            shown(height_m)
         ))
     }
 }

@@ -207,7 +207,11 @@ pub const MAX_FACE_GROWTH: f64 = 10.0;
 /// infinite error is a failed fit, never a result), every vertex finite and the face at most
 /// [`MAX_FACE_GROWTH`] times the generic one. Errors name the view (its landmark file).
 pub fn check_fit(fit: &FaceFit, errors: &[f64]) -> Result<(), FaceError> {
-    let name = |v: usize| fit.views.get(v).map_or_else(String::new, |v| v.name.clone());
+    let name = |v: usize| {
+        fit.views
+            .get(v)
+            .map_or_else(String::new, |v| v.name.clone())
+    };
     if let Some(v) = errors.iter().position(|e| !e.is_finite()) {
         return Err(FaceError::Landmarks {
             source_name: name(v),

@@ -206,7 +206,9 @@ pub fn check_geometry(points: &[[f64; 2]], source: &str) -> Result<(), FaceError
         sxy += dx * dy / n;
     }
     let half = 0.5 * (sxx + syy);
-    let minor = (half - (0.25 * (sxx - syy).powi(2) + sxy * sxy).sqrt()).max(0.0).sqrt();
+    let minor = (half - (0.25 * (sxx - syy).powi(2) + sxy * sxy).sqrt())
+        .max(0.0)
+        .sqrt();
     if !(minor >= MIN_SPREAD_IOD * iod) {
         return Err(err(format!(
             "degenerate landmarks: the points lie on a line (spread {minor:.3} px across it, less than {MIN_SPREAD_IOD} × the inter-ocular distance {iod:.1} px)"

@@ -69,10 +69,21 @@ impl Range {
             };
             let above = if self.lo_open { "above " } else { "" };
             Err(format!(
-                "{v}{unit} is outside the range of real fabrics, {above}{} … {}{unit} (docs/kes-lab.md, \"Ranges of real fabrics\")",
-                self.lo, self.hi
+                "{}{unit} is outside the range of real fabrics, {above}{} … {}{unit} (docs/kes-lab.md, \"Ranges of real fabrics\")",
+                shown(v),
+                self.lo,
+                self.hi
             ))
         }
+    }
+}
+
+/// `v` for a message: plain for ordinary magnitudes, in exponent form for huge or tiny ones.
+fn shown(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && !(1e-4..1e6).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
     }
 }
 
@@ -145,7 +156,9 @@ mod tests {
             assert!(r.lo < r.hi && !r.contains(f64::NAN) && !r.contains(-1.0));
         }
         // the maths notes' §2.2 extremes of B and the HESC suiting's RT
-        assert!(param_range(KesParam::B).contains(0.0023) && param_range(KesParam::B).contains(2.71));
+        assert!(
+            param_range(KesParam::B).contains(0.0023) && param_range(KesParam::B).contains(2.71)
+        );
         assert!(param_range(KesParam::Rt).contains(75.0));
         assert!(!param_range(KesParam::B).contains(1e308));
         let e = param_range(KesParam::Rt).check(120.0).unwrap_err();

@@ -295,10 +295,10 @@ fn corner(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::fs;
     use crate::geometry::grid_mesh;
     use crate::geometry::obj::write_obj;
     use crate::geometry::ExportFrame;
+    use std::fs;
 
     fn tmp(name: &str) -> std::path::PathBuf {
         std::env::temp_dir().join(format!("emilion-obj-{}-{name}", std::process::id()))
