@@ -1,7 +1,9 @@
 //! A small XML reader for the SVG importer: elements, attributes (entities decoded) and their
 //! line numbers. Comments, processing instructions, the DOCTYPE, CDATA and text are skipped;
 //! namespaces are not resolved (names keep their prefix). Malformed input gives the line and
-//! column of the problem, never a panic.
+//! column of the problem, never a panic; elements nested deeper than the limit `max_nesting`
+//! are an error at the line of the first one too deep. Nothing here recurses: parsing, and
+//! dropping a tree, use explicit stacks.
 
 /// An XML element.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -14,6 +16,16 @@ pub(crate) struct Element {
     pub children: Vec<Element>,
     /// The 1-based line of the start tag.
     pub line: usize,
+}
+
+impl Drop for Element {
+    /// Drops the subtree with an explicit stack (a deep tree would overflow the call stack).
+    fn drop(&mut self) {
+        let mut stack = std::mem::take(&mut self.children);
+        while let Some(mut el) = stack.pop() {
+            stack.append(&mut el.children);
+        }
+    }
 }
 
 impl Element {
@@ -121,8 +133,9 @@ impl Reader<'_> {
         let name = self.name()?;
         let mut el = Element {
             name,
+            attrs: Vec::new(),
+            children: Vec::new(),
             line: self.position(tag_start).0,
-            ..Element::default()
         };
         loop {
             self.skip_ws();
@@ -217,6 +230,7 @@ pub(crate) fn parse(text: &str) -> Result<Element, XmlError> {
         pos: 0,
         line_starts,
     };
+    let max_depth = crate::limits::get().max_nesting;
     let mut stack: Vec<Element> = Vec::new();
     let mut root: Option<Element> = None;
     while let Some(i) = r.rest().find('<') {
@@ -268,6 +282,16 @@ pub(crate) fn parse(text: &str) -> Result<Element, XmlError> {
                     }
                 }
             } else {
+                if stack.len() as u64 >= max_depth {
+                    return Err(r.error(
+                        tag_start,
+                        format!(
+                            "<{}> is nested {} elements deep, over the limit max_nesting = {max_depth} (raise it with `emilion run --limit max_nesting=N`)",
+                            el.name,
+                            stack.len() + 1
+                        ),
+                    ));
+                }
                 stack.push(el);
             }
         }
