@@ -321,6 +321,29 @@ mod tests {
     }
 
     #[test]
+    fn elements_nested_past_max_nesting_are_an_error_at_their_line() {
+        let deep = format!("<svg>\n{}{}</svg>", "<g>\n".repeat(300), "</g>".repeat(300));
+        let e = parse(&deep).unwrap_err();
+        // the svg is level 1, so the 256th <g> (line 257) is the first too deep
+        assert_eq!(e.line, 257, "{e:?}");
+        assert!(e.message.contains("max_nesting = 256"), "{e:?}");
+        let ok = format!("<svg>{}{}</svg>", "<g>".repeat(255), "</g>".repeat(255));
+        assert!(parse(&ok).is_ok());
+    }
+
+    #[test]
+    fn a_deep_tree_drops_without_recursion() {
+        // deeper than any test thread's stack allows for a recursive drop
+        let mut el = Element::default();
+        for _ in 0..1_000_000 {
+            let mut parent = Element::default();
+            parent.children.push(el);
+            el = parent;
+        }
+        drop(el);
+    }
+
+    #[test]
     fn reports_positions_of_errors() {
         let e = parse("<svg>\n<g>\n</svg>").unwrap_err();
         assert_eq!((e.line, e.column), (3, 1), "{e:?}");
@@ -328,10 +351,8 @@ mod tests {
         assert_eq!(e.line, 2);
         assert!(parse("<svg><g></g>").is_err());
         assert!(parse("").is_err());
-        let el = Element {
-            attrs: vec![("xlink:href".into(), "#n".into())],
-            ..Element::default()
-        };
+        let mut el = Element::default();
+        el.attrs.push(("xlink:href".into(), "#n".into()));
         assert_eq!(el.attr("href"), Some("#n"));
     }
 }
