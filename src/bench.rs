@@ -8,7 +8,12 @@ use serde::Serialize;
 
 use crate::cloth::ClothError;
 use crate::contact::SimulationContact;
+use crate::limits;
 use crate::scenes;
+
+fn limit_err(e: limits::LimitError) -> ClothError {
+    ClothError::Parameter(e.to_string())
+}
 
 /// One benchmark case's result.
 #[derive(Debug, Clone, Serialize)]
@@ -68,7 +73,8 @@ pub fn bench_hang(n: usize, frames: u32, runs: usize) -> Result<BenchResult, Clo
 }
 
 /// Runs scene `scene` ("hang", "drape" or "hang_self") at `n` × `n` for `frames` frames of 5
-/// substeps, `runs` times after one warm-up run, and returns the median run.
+/// substeps, `runs` times after one warm-up run, and returns the median run. A size over the
+/// limit `max_particles` or a frame count over `max_frames` is refused before anything is built.
 pub fn bench_scene(
     scene: &str,
     n: usize,
@@ -77,6 +83,12 @@ pub fn bench_scene(
 ) -> Result<BenchResult, ClothError> {
     let substeps = 5;
     let runs = runs.max(1);
+    let lim = limits::get();
+    let particles = (n as f64) * (n as f64);
+    let what = format!("bench size {n} × {n} particles");
+    limits::check(&what, particles, "max_particles", lim.max_particles).map_err(limit_err)?;
+    limits::check_count("bench frames", frames as u64, "max_frames", lim.max_frames)
+        .map_err(limit_err)?;
     let mut results = Vec::new();
     let mut contact = Vec::new();
     for r in 0..=runs {
@@ -93,7 +105,7 @@ pub fn bench_scene(
         // per-step intersection counting is a diagnostic, not part of the solver: the final
         // state is checked once after the timed loop
         sim.add_contact().settings.count_intersections = false;
-        let steps = (frames * substeps) as u64;
+        let steps = frames as u64 * substeps as u64;
         let t0 = Instant::now();
         sim.run_steps(steps, |_, _| Ok(()))?;
         let ms = t0.elapsed().as_secs_f64() * 1e3 / steps as f64;

@@ -57,6 +57,12 @@ impl Channel {
     }
 }
 
+/// Shortest accepted frame time (s): 0.1 ms, a 10 kHz capture, faster than any motion-capture
+/// system records.
+pub const MIN_FRAME_TIME: f64 = 1e-4;
+/// Longest accepted frame time (s): 10 s between frames, slower than any clip is keyed.
+pub const MAX_FRAME_TIME: f64 = 10.0;
+
 /// One joint of a BVH hierarchy (an `End Site` is a joint without channels).
 #[derive(Clone, Debug)]
 pub struct BvhJoint {
@@ -175,8 +181,9 @@ impl Motion {
     /// Parses BVH text; `name_for_errors` names the text in errors (usually its path).
     ///
     /// Fails (never panics) on a truncated text, a malformed number, an unknown channel, a
-    /// duplicate joint name, an end site with channels or children, no frames, or a
-    /// non-positive frame time.
+    /// duplicate joint name, an end site with channels or children, joints nested deeper than
+    /// the limit `max_nesting`, no frames or more than the limit `max_frames`, or a frame time
+    /// outside [[`MIN_FRAME_TIME`], [`MAX_FRAME_TIME`]].
     pub fn parse_bvh(text: &str, name_for_errors: &str) -> Result<Motion, BodyError> {
         let file = name_for_errors;
         let mut lx = Lexer::new(text, file);
@@ -255,6 +262,17 @@ impl Motion {
                     } else {
                         lx.expect_any("a joint name")?.1.to_string()
                     };
+                    let max_depth = crate::limits::get().max_nesting;
+                    if stack.len() as u64 >= max_depth {
+                        return Err(BodyError::parse(
+                            file,
+                            line,
+                            format!(
+                                "joint nested {} deep, over the limit max_nesting = {max_depth} (raise it with `emilion run --limit max_nesting=N`)",
+                                stack.len() + 1
+                            ),
+                        ));
+                    }
                     let j = add(&mut joints, name, Some(top), end_site, line)?;
                     lx.expect("{")?;
                     stack.push(j);
@@ -277,14 +295,24 @@ impl Motion {
         if frame_count == 0 {
             return Err(BodyError::parse(file, fl, "the clip has no frames"));
         }
+        let max_frames = crate::limits::get().max_frames;
+        crate::limits::check_count(
+            "the number of frames",
+            frame_count as u64,
+            "max_frames",
+            max_frames,
+        )
+        .map_err(|e| BodyError::parse(file, fl, e.to_string()))?;
         lx.expect("Frame")?;
         let tl = lx.expect("Time:")?;
         let frame_time = lx.number("the frame time")?;
-        if frame_time <= 0.0 {
+        if !(MIN_FRAME_TIME..=MAX_FRAME_TIME).contains(&frame_time) {
             return Err(BodyError::parse(
                 file,
                 tl,
-                "the frame time must be positive",
+                format!(
+                    "the frame time {frame_time} s is outside the accepted range [{MIN_FRAME_TIME}, {MAX_FRAME_TIME}] s"
+                ),
             ));
         }
         let total = frame_count

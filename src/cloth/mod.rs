@@ -9,6 +9,7 @@ pub mod elements;
 pub mod error;
 pub mod model;
 pub mod parameters;
+pub mod runs;
 pub mod sewing;
 pub mod simulation;
 pub mod solver;
@@ -21,7 +22,9 @@ pub use elements::material::{Direction, FabricParameters, Friction, LinearMateri
 pub use elements::measured::{MeasuredLaw, ResponseCurve};
 pub use error::ClothError;
 pub use model::ClothModel;
-pub use parameters::{Integrator, PreconditionerKind, SimulationParameters};
+pub use parameters::{
+    Integrator, PreconditionerKind, SimulationParameters, MAX_DT, MAX_EXPLICIT_SUBSTEPS, MIN_DT,
+};
 pub use sewing::{Separation, Sewing};
 pub use simulation::Simulation;
 pub use stage::{Obstacles, StepEnd, StepStage};

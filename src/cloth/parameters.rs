@@ -30,6 +30,16 @@ pub enum PreconditionerKind {
     Aggregation,
 }
 
+/// Shortest accepted step (s): 0.1 µs, far below what any cloth needs (the stiffest
+/// explicit runs use 10⁻⁴ s) and far above where a run's step count stops fitting
+/// `max_steps`.
+pub const MIN_DT: f64 = 1e-7;
+/// Longest accepted step (s): one second, the coarsest step an implicit drape is ever run at.
+pub const MAX_DT: f64 = 1.0;
+/// Most explicit substeps per step: 10,000 (a 1 µs substep at dt = 1/100 s, more than the
+/// stiffest fabric on the finest grid asks for).
+pub const MAX_EXPLICIT_SUBSTEPS: u32 = 10_000;
+
 /// Smallest non-grid cloth that [`PreconditionerKind::Auto`] preconditions with aggregation
 /// multigrid.
 pub const AGGREGATION_MIN: usize = 1000;
@@ -38,7 +48,7 @@ pub const AGGREGATION_MIN: usize = 1000;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct SimulationParameters {
-    /// Step length (s).
+    /// Step length (s), in [`MIN_DT`, `MAX_DT`].
     pub dt: f64,
     /// Which integrator advances the state.
     pub integrator: Integrator,
@@ -50,7 +60,7 @@ pub struct SimulationParameters {
     pub cg_max_iterations: u32,
     /// Start CG from the previous step's velocity change.
     pub warm_start: bool,
-    /// Substeps per step for the explicit integrator.
+    /// Substeps per step for the explicit integrator, 1 to [`MAX_EXPLICIT_SUBSTEPS`].
     pub explicit_substeps: u32,
     /// A particle faster than this (m/s) means the simulation blew up.
     pub max_speed: f64,
@@ -75,13 +85,17 @@ impl Default for SimulationParameters {
 }
 
 impl SimulationParameters {
-    /// Checks the values, naming the first bad parameter.
+    /// Checks the values, naming the first bad parameter: `dt` in [`MIN_DT`, `MAX_DT`] s,
+    /// `explicit_substeps` in 1..=[`MAX_EXPLICIT_SUBSTEPS`].
     pub fn validate(&self) -> Result<(), ClothError> {
         let bad = |name: &str, v: f64| {
             ClothError::Parameter(format!("simulation parameter `{name}` is invalid: {v}"))
         };
-        if !(self.dt.is_finite() && self.dt > 0.0) {
-            return Err(bad("dt", self.dt));
+        if !(self.dt.is_finite() && (MIN_DT..=MAX_DT).contains(&self.dt)) {
+            return Err(ClothError::Parameter(format!(
+                "simulation parameter `dt` is {} s, outside the accepted range [{MIN_DT:e}, {MAX_DT}] s",
+                super::runs::short_number(self.dt)
+            )));
         }
         if !(self.cg_tolerance.is_finite() && self.cg_tolerance > 0.0) {
             return Err(bad("cg_tolerance", self.cg_tolerance));
@@ -92,8 +106,11 @@ impl SimulationParameters {
         if let Some(g) = self.gravity.iter().find(|g| !g.is_finite()) {
             return Err(bad("gravity", *g));
         }
-        if self.explicit_substeps == 0 {
-            return Err(bad("explicit_substeps", 0.0));
+        if !(1..=MAX_EXPLICIT_SUBSTEPS).contains(&self.explicit_substeps) {
+            return Err(ClothError::Parameter(format!(
+                "simulation parameter `explicit_substeps` is {}, outside the accepted range 1..={MAX_EXPLICIT_SUBSTEPS}",
+                self.explicit_substeps
+            )));
         }
         Ok(())
     }

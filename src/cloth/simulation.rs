@@ -193,8 +193,10 @@ impl Simulation {
         Ok(self.attachments.len() - 1)
     }
 
-    /// Removes every attachment of `particles` (they become free).
-    pub fn release(&mut self, particles: &[usize]) {
+    /// Removes every attachment of `particles` (they become free); an index past the cloth's
+    /// particles is an error (nothing is released then).
+    pub fn release(&mut self, particles: &[usize]) -> Result<(), ClothError> {
+        self.check_particles(particles)?;
         for at in &mut self.attachments {
             let keep: Vec<bool> = at
                 .particles
@@ -207,6 +209,7 @@ impl Simulation {
             at.anchors.retain(|_| *k.next().unwrap());
         }
         self.attachments.retain(|a| !a.particles.is_empty());
+        Ok(())
     }
 
     /// Target position of every attached particle at time `t`.
@@ -579,24 +582,5 @@ impl Simulation {
             converged: true,
             ..Default::default()
         }
-    }
-
-    /// Runs `steps` steps, calling `each` after every step; stops at the first error.
-    pub fn run_steps(
-        &mut self,
-        steps: u64,
-        mut each: impl FnMut(&Simulation, &StepStats) -> Result<(), ClothError>,
-    ) -> Result<(), ClothError> {
-        self.stats.reserve(steps as usize);
-        for _ in 0..steps {
-            let st = self.step()?;
-            each(self, &st)?;
-        }
-        Ok(())
-    }
-
-    /// Number of steps needed to cover `seconds`.
-    pub fn steps_for(&self, seconds: f64) -> u64 {
-        (seconds / self.params.dt - 1e-9).ceil().max(0.0) as u64
     }
 }

@@ -126,6 +126,10 @@ pub fn dress(
         .contact
         .validate()
         .map_err(|e| PatternError::Parameter(e.to_string()))?;
+    // before the meshing and pre-positioning, which take seconds
+    sim_params
+        .validate()
+        .map_err(|e| PatternError::Parameter(e.to_string()))?;
     let t0 = Instant::now();
     let garment = mesh_pattern(pattern, &params.mesh)?;
     let t1 = Instant::now();

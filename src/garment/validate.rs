@@ -1,6 +1,8 @@
 //! Checks of a [`Pattern`]: pieces that can be meshed and seams that can be sewn.
 //!
-//! A piece needs at least three corners with unique names, finite coordinates, a grain line
+//! A piece needs at least three corners with unique names, finite coordinates within
+//! ±[`MAX_COORDINATE`] m, an outline (control points included) that fits a [`MAX_PIECE_SIZE`]
+//! square, a seam allowance of at most [`MAX_SEAM_ALLOWANCE`], a grain line
 //! of non-zero length, a counter-clockwise outline of positive area (importers turn clockwise
 //! outlines round, so a clockwise one here is a bug of whoever built the pattern) that does
 //! not cross itself (tested on the outline flattened to [`CROSSING_TOLERANCE`]), edges of
@@ -15,7 +17,7 @@
 use std::collections::BTreeMap;
 
 use super::error::PatternError;
-use super::pattern::{EdgeRef, Outline, Pattern, Piece, Segment, P2};
+use super::pattern::{Corner, EdgeRef, Outline, Pattern, Piece, Segment, P2};
 
 /// Flattening tolerance for the self-intersection test (m).
 pub const CROSSING_TOLERANCE: f64 = 1e-4;
@@ -27,6 +29,16 @@ pub const SEAM_LENGTH_RELATIVE: f64 = 0.01;
 pub const LEVELS: [&str; 8] = [
     "neck", "shoulder", "chest", "waist", "hip", "crotch", "knee", "ankle",
 ];
+
+/// Largest piece (m): its outline, control points included, fits a 10 m × 10 m square. No
+/// garment piece comes near it (a floor-length circle skirt is under 3 m across); a bigger one
+/// is a unit mistake (a pattern in mm read as m) or a broken file.
+pub const MAX_PIECE_SIZE: f64 = 10.0;
+/// Largest coordinate magnitude (m) of any point of a pattern (corners, control points, grain
+/// line, notches): pieces laid out on a sheet stay well within ±1 km.
+pub const MAX_COORDINATE: f64 = 1000.0;
+/// Largest seam allowance (m).
+pub const MAX_SEAM_ALLOWANCE: f64 = 1.0;
 
 /// Smallest accepted outline area (m²) and edge or grain length (m).
 const MIN_AREA: f64 = 1e-6;
@@ -80,7 +92,7 @@ impl Piece {
                 corners.len()
             )));
         }
-        let finite = |p: &P2| p[0].is_finite() && p[1].is_finite();
+        let finite = |p: &P2| p.iter().all(|c| c.is_finite() && c.abs() <= MAX_COORDINATE);
         let mut names = BTreeMap::new();
         for (i, c) in corners.iter().enumerate() {
             if c.name.is_empty() {
@@ -98,25 +110,35 @@ impl Piece {
             };
             if !finite(&c.at) || !controls_finite {
                 return Err(err(format!(
-                    "corner '{}' has a coordinate that is not a finite number",
-                    c.name
+                    "corner '{}' (at {:?}) has a coordinate that is not a finite number within ±{MAX_COORDINATE} m",
+                    c.name, c.at
                 )));
             }
         }
+        let (w, h) = extent(corners);
+        if w > MAX_PIECE_SIZE || h > MAX_PIECE_SIZE {
+            return Err(err(format!(
+                "the piece spans {w:.3} m × {h:.3} m, over the largest accepted piece size of {MAX_PIECE_SIZE} m (a pattern in mm read as metres?)"
+            )));
+        }
         if !self.grain.iter().all(finite) || dist(self.grain[0], self.grain[1]) < MIN_LENGTH {
             return Err(err(format!(
-                "the grain line {:?} → {:?} is degenerate (zero length or not finite)",
+                "the grain line {:?} → {:?} is degenerate (zero length, or not finite within ±{MAX_COORDINATE} m)",
                 self.grain[0], self.grain[1]
             )));
         }
-        if !self.seam_allowance.is_finite() || self.seam_allowance < 0.0 {
+        if !(self.seam_allowance.is_finite()
+            && (0.0..=MAX_SEAM_ALLOWANCE).contains(&self.seam_allowance))
+        {
             return Err(err(format!(
-                "seam allowance {} m is not a non-negative number",
+                "seam allowance {} m is not a number in [0, {MAX_SEAM_ALLOWANCE}] m",
                 self.seam_allowance
             )));
         }
         if let Some(bad) = self.notches.iter().find(|p| !finite(p)) {
-            return Err(err(format!("notch {bad:?} is not finite")));
+            return Err(err(format!(
+                "notch {bad:?} is not finite within ±{MAX_COORDINATE} m"
+            )));
         }
         for i in 0..corners.len() {
             if self.outline.segment_length(i) < MIN_LENGTH {
@@ -188,6 +210,25 @@ pub(crate) fn edge_name(outline: &Outline, i: usize) -> String {
 
 fn dist(a: P2, b: P2) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+/// Width and height (m) of the box around the corners and control points.
+fn extent(corners: &[Corner]) -> (f64, f64) {
+    let points = corners.iter().flat_map(|c| {
+        let controls = match &c.segment {
+            Segment::Line => [c.at, c.at],
+            Segment::Cubic { c1, c2 } => [*c1, *c2],
+        };
+        std::iter::once(c.at).chain(controls)
+    });
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in points {
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (hi[0] - lo[0], hi[1] - lo[1])
 }
 
 fn check_pieces(pieces: &[Piece], source: &str) -> Result<(), PatternError> {

@@ -9,7 +9,8 @@ use super::{GeometryError, TriMesh, Vec3};
 /// (vertex `(i, j)` — row `i` from the bottom rim up, column `j` around — has index
 /// `i * n_around + j`, so the last row is the top rim). The pattern is the annular sector that
 /// rolls up exactly into this cone, minus a slit of `slit` (fraction of the circumference,
-/// 0 ≤ slit < 1) at the back (+y); the front is at −y.
+/// 0 ≤ slit < 1) at the back (+y); the front is at −y. More than
+/// `limits::get().max_particles` vertices is an error.
 pub fn cone_mesh(
     r_top: f64,
     r_bottom: f64,
@@ -35,6 +36,7 @@ pub fn cone_mesh(
             "cone needs at least 3 × 2 vertices, got {n_around} × {n_down}"
         )));
     }
+    super::grid::check_lattice("cone n_around × n_down", n_around, n_down)?;
     let slant = ((r_bottom - r_top).powi(2) + height * height).sqrt();
     let mut positions = Vec::with_capacity(n_around * n_down);
     let mut rest = Vec::with_capacity(n_around * n_down);

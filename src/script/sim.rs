@@ -278,10 +278,9 @@ pub fn register(engine: &mut ApiBuilder) {
         engine,
         "release",
         ["sim: Simulation", "particles: Array"],
-        "Frees particles from every pin and attachment.",
+        "Frees particles from every pin and attachment; an index past the cloth's particles is an error.",
         |h: &mut SimHandle, p: Array| -> RResult<()> {
-            h.get_mut()?.release(&indices(&p, "particle")?);
-            Ok(())
+            Ok(h.get_mut()?.release(&indices(&p, "particle")?)?)
         }
     );
     register!(
@@ -344,7 +343,7 @@ up/down choice on a flat cloth (one side of the cloth per step for all its ties)
         engine,
         "run_steps",
         ["sim: Simulation", "steps: int"],
-        "Advances `steps` steps.",
+        "Advances `steps` steps (at most the limit `max_steps`, see docs/limits.md).",
         |h: &mut SimHandle, n: INT| -> RResult<()> {
             run_n(h, count(&Dynamic::from_int(n), "steps")? as u64)
         }
@@ -353,17 +352,18 @@ up/down choice on a flat cloth (one side of the cloth per step for all its ties)
         engine,
         "run",
         ["sim: Simulation", "seconds: float"],
-        "Advances `seconds` of simulated time (rounded up to whole steps).",
+        "Advances `seconds` of simulated time (rounded up to whole steps, at most the limit\n`max_steps`, see docs/limits.md).",
         |h: &mut SimHandle, secs: Dynamic| -> RResult<()> {
-            let n = h.get()?.steps_for(finite(&secs, "seconds")?);
+            let n = h.get()?.checked_steps_for(finite(&secs, "seconds")?)?;
             run_n(h, n)
         }
     );
     register!(engine, "run", ["sim: Simulation", "seconds: float", "callback: FnPtr"],
         "Advances `seconds`, calling `callback(#{frame, time, step, sim})` after every step\n(`frame` counts the steps of this run from 1). A callback returning `false` stops the run.\nInside the callback the simulation is `this` (or `t.sim`); Rhai forbids capturing `sim` itself.",
         |ctx: NativeCallContext, h: &mut SimHandle, secs: Dynamic, f: FnPtr| -> RResult<()> {
-            let n = h.get()?.steps_for(finite(&secs, "seconds")?);
+            let n = h.get()?.checked_steps_for(finite(&secs, "seconds")?)?;
             for k in 1..=n {
+                crate::limits::check_cancelled().map_err(rt_err)?;
                 let info = {
                     let mut s = h.get_mut()?;
                     s.step()?;
@@ -379,12 +379,17 @@ up/down choice on a flat cloth (one side of the cloth per step for all its ties)
         "Runs `frames` frames at `fps`, stepping to each frame time and then calling\n`callback(#{frame, time, step, sim})` (`frame` from 1). A callback returning `false` stops the run.\nWith a recording started (`record`), each frame is added to it and the cache is written at the end.\nInside the callback the simulation is `this` (or `t.sim`); Rhai forbids capturing `sim` itself.",
         |ctx: NativeCallContext, h: &mut SimHandle, frames: INT, fps: Dynamic, f: FnPtr| -> RResult<()> {
             let frames = count(&Dynamic::from_int(frames), "frames")? as u64;
+            let max = crate::limits::get().max_frames;
+            crate::limits::check_count("run_frames `frames`", frames, "max_frames", max).map_err(rt_err)?;
             let fps = finite(&fps, "fps")?;
             if fps <= 0.0 {
                 return Err(rt_err(format!("`fps` must be > 0, got {fps}")));
             }
+            // the whole run's steps, refused before the first one
+            h.get()?.checked_steps_for(frames as f64 / fps)?;
             let t0 = h.get()?.state.time;
             for k in 1..=frames {
+                crate::limits::check_cancelled().map_err(rt_err)?;
                 let info = {
                     let mut s = h.get_mut()?;
                     let n = s.steps_for(t0 + k as f64 / fps - s.state.time);

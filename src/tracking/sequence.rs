@@ -55,10 +55,12 @@ use super::joints::{JointSet, TRACKING_JOINTS};
 use super::sequence_files::{
     cover, image_path, io_err, list_photos, write_joints_csv, write_png, JointFrame, SequenceError,
 };
+use crate::body::bvh::{MAX_FRAME_TIME, MIN_FRAME_TIME};
 use crate::body::{Animation, BodyError, Mannequin, Motion, RetargetOptions};
 use crate::geometry::files::data_dir;
 use crate::geometry::Camera;
 use crate::geometry::{SplitMix64, Vec3};
+use crate::limits;
 use crate::render::raster::{draw_triangles, project_vertices, RasterTarget};
 
 /// Settings of [`make_sequence`]; see the [module docs](self) for what each does.
@@ -71,9 +73,10 @@ pub struct SequenceOptions {
     pub width: u32,
     /// Image height, pixels (16..=8192). Default 240.
     pub height: u32,
-    /// Frames per second. Default 50.
+    /// Frames per second, 0.1 to 10,000 (a BVH's frame time range). Default 50.
     pub fps: f64,
-    /// Number of frames; `None` (default) = the whole clip at `fps`.
+    /// Number of frames, at most the limit `max_frames`; `None` (default) = the whole clip at
+    /// `fps`.
     pub frames: Option<usize>,
     /// Clip time (seconds) of frame 0. Default 0.
     pub start_time: f64,
@@ -134,12 +137,17 @@ impl SequenceOptions {
                 return bad(format!("{name} must be in 16..=8192 pixels, got {v}"));
             }
         }
-        if !(self.fps.is_finite() && self.fps > 0.0) {
-            return bad(format!("fps must be positive, got {}", self.fps));
-        }
-        if matches!(self.frames, Some(0)) || self.frames.is_some_and(|f| f > 1_000_000) {
+        let (min_fps, max_fps) = (1.0 / MAX_FRAME_TIME, 1.0 / MIN_FRAME_TIME);
+        if !(self.fps.is_finite() && (min_fps..=max_fps).contains(&self.fps)) {
             return bad(format!(
-                "frames must be in 1..=1000000, got {:?}",
+                "fps must be in [{min_fps}, {max_fps}] frames per second, got {}",
+                self.fps
+            ));
+        }
+        let max_frames = limits::get().max_frames;
+        if matches!(self.frames, Some(0)) || self.frames.is_some_and(|f| f as u64 > max_frames) {
+            return bad(format!(
+                "frames must be in 1..={max_frames} (the limit max_frames), got {:?}",
                 self.frames
             ));
         }
@@ -385,9 +393,20 @@ pub fn make_sequence(
         ..RetargetOptions::default()
     };
     let anim = Animation::new(mannequin, clip, retarget)?;
-    let frames = o
-        .frames
-        .unwrap_or_else(|| (anim.duration() * o.fps + 1e-9).floor() as usize + 1);
+    let frames = match o.frames {
+        Some(f) => f,
+        None => {
+            let n = (anim.duration() * o.fps + 1e-9).floor() + 1.0;
+            let what = format!(
+                "the frame count of {} ({} s at {} fps)",
+                motion.display(),
+                anim.duration(),
+                o.fps
+            );
+            limits::check(&what, n, "max_frames", limits::get().max_frames)
+                .map_err(|e| SequenceError::Options(e.to_string()))? as usize
+        }
+    };
     let time = |k: usize| k as f64 / o.fps;
 
     // ground truth first: it places the cameras' occluders

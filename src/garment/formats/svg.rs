@@ -25,7 +25,9 @@
 //! points become corners, consecutive corners closer than [`SvgOptions::merge_distance`] are
 //! merged, cubics whose control points lie on their chord become lines, the outline is made
 //! counter-clockwise keeping the path's start as `c0`, and corners are named `c0, c1, …` in
-//! that order. Other elements are ignored.
+//! that order. Other elements are ignored. A `viewBox` that is not four numbers with a positive
+//! width and height is an error, and so are elements nested deeper than the limit
+//! `max_nesting` (docs/limits.md).
 //!
 //! The pieces of the reader are submodules: `xml` (the document), `path` (path data),
 //! `transform` (transform lists) and `shape` (basic shapes and markings).
@@ -97,7 +99,7 @@ pub(crate) fn parse_pattern_svg_file(
     path: &Path,
     options: &SvgOptions,
 ) -> Result<Pattern, PatternError> {
-    let text = std::fs::read_to_string(path).map_err(|source| PatternError::Io {
+    let text = crate::limits::read_to_string(path).map_err(|source| PatternError::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -186,7 +188,33 @@ fn length_mm(v: &str) -> Option<f64> {
     Some(x * per)
 }
 
+/// The root's `viewBox` width, if it has one; a `viewBox` that is not four finite numbers with
+/// a positive width and height (SVG draws nothing then) is an error.
+fn view_box_width(root: &Element, path: &Path) -> Result<Option<f64>, PatternError> {
+    let Some(vb) = root.attr("viewBox") else {
+        return Ok(None);
+    };
+    let v: Option<Vec<f64>> = vb
+        .split(|c: char| c.is_whitespace() || c == ',')
+        .filter(|s| !s.is_empty())
+        .map(|s| s.parse().ok())
+        .collect();
+    match v {
+        Some(v) if v.len() == 4 && v.iter().all(|x| x.is_finite()) && v[2] > 0.0 && v[3] > 0.0 => {
+            Ok(Some(v[2]))
+        }
+        _ => Err(PatternError::Parse {
+            path: path.to_path_buf(),
+            line: root.line,
+            message: format!(
+                "viewBox=\"{vb}\" is not four numbers with a positive width and height (the drawing would be empty)"
+            ),
+        }),
+    }
+}
+
 fn units(root: &Element, options: &SvgOptions, path: &Path) -> Result<f64, PatternError> {
+    let view_w = view_box_width(root, path)?;
     if let Some(s) = options.metres_per_unit {
         if s.is_finite() && s > 0.0 {
             return Ok(s);
@@ -195,13 +223,6 @@ fn units(root: &Element, options: &SvgOptions, path: &Path) -> Result<f64, Patte
             "metres_per_unit {s} is not a positive number"
         )));
     }
-    let view_w = root.attr("viewBox").and_then(|vb| {
-        let v: Vec<f64> = vb
-            .split(|c: char| c.is_whitespace() || c == ',')
-            .filter_map(|s| s.parse().ok())
-            .collect();
-        (v.len() == 4 && v[2] > 0.0).then_some(v[2])
-    });
     let width = root.attr("width").and_then(length_mm);
     let mm = match (width, view_w) {
         (Some(w), Some(vw)) if w > 0.0 => w / vw,
@@ -230,19 +251,28 @@ fn classes(el: &Element) -> Vec<&str> {
         .unwrap_or_default()
 }
 
-fn walk(el: &Element, t: Affine, ctx: &Ctx, pieces: &mut Vec<Piece>) -> Result<(), PatternError> {
-    for child in &el.children {
-        let name = child.local_name();
+/// Visits the groups under `root` in document order (depth first, with an explicit stack:
+/// the nesting depth is the file's), collecting the pieces.
+fn walk(
+    root: &Element,
+    root_t: Affine,
+    ctx: &Ctx,
+    pieces: &mut Vec<Piece>,
+) -> Result<(), PatternError> {
+    let mut stack: Vec<(&Element, Affine)> =
+        root.children.iter().rev().map(|c| (c, root_t)).collect();
+    while let Some((el, t)) = stack.pop() {
+        let name = el.local_name();
         if SKIPPED.contains(&name) || name != "g" && name != "svg" {
             continue;
         }
-        let ct = t.then_inner(&transform_of(child, ctx)?);
-        if let (Some(id), "g") = (child.attr("id"), name) {
-            if let Some(piece) = piece_of(child, id, &ct, ctx)? {
+        let ct = t.then_inner(&transform_of(el, ctx)?);
+        if let (Some(id), "g") = (el.attr("id"), name) {
+            if let Some(piece) = piece_of(el, id, &ct, ctx)? {
                 pieces.push(piece);
             }
         }
-        walk(child, ct, ctx, pieces)?;
+        stack.extend(el.children.iter().rev().map(|c| (c, ct)));
     }
     Ok(())
 }

@@ -157,6 +157,7 @@ pub fn mesh_pattern(
         }
         frames.push([dx / len, dy / len]);
     }
+    check_particle_estimate(pattern, &curves, h, &src)?;
     let plan = plan(pattern, &curves, h)?;
 
     let mut out = GarmentMesh {
@@ -210,6 +211,37 @@ pub fn mesh_pattern(
         });
     }
     Ok(out)
+}
+
+/// Refuses, before anything is meshed, a pattern whose estimated vertex count at edge length
+/// `h` is over the limit `max_particles`. The estimate per piece is the interior lattice
+/// (area / (h² · √3/2): one vertex per rhombus of two equilateral triangles of side `h`) plus
+/// the boundary samples (perimeter / `h`).
+fn check_particle_estimate(
+    pattern: &Pattern,
+    curves: &[Vec<Curve>],
+    h: f64,
+    src: &str,
+) -> Result<(), PatternError> {
+    let per_vertex = h * h * 3f64.sqrt() / 2.0;
+    let estimate: f64 = pattern
+        .pieces
+        .iter()
+        .zip(curves)
+        .map(|(piece, segs)| {
+            let perimeter: f64 = segs.iter().map(|c| c.length).sum();
+            piece.outline.area().abs() / per_vertex + perimeter / h
+        })
+        .sum();
+    let what = format!("{src}: the estimated vertex count at edge_length {h} m");
+    crate::limits::check(
+        &what,
+        estimate.ceil(),
+        "max_particles",
+        crate::limits::get().max_particles,
+    )
+    .map(|_| ())
+    .map_err(|e| PatternError::Parameter(e.to_string()))
 }
 
 /// Interior lattice points closer than this (× edge length) to the boundary are dropped.

@@ -43,7 +43,7 @@ pub fn rectangle_mesh(width: f64, height: f64, edge_length: f64) -> Result<TriMe
     };
     let pattern = Pattern {
         name: "rectangle".into(),
-        source: "rectangle".into(),
+        source: format!("rectangle {width} m × {height} m"),
         pieces: vec![piece],
         seams: Vec::new(),
     };

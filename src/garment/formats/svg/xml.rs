@@ -1,7 +1,9 @@
 //! A small XML reader for the SVG importer: elements, attributes (entities decoded) and their
 //! line numbers. Comments, processing instructions, the DOCTYPE, CDATA and text are skipped;
 //! namespaces are not resolved (names keep their prefix). Malformed input gives the line and
-//! column of the problem, never a panic.
+//! column of the problem, never a panic; elements nested deeper than the limit `max_nesting`
+//! are an error at the line of the first one too deep. Nothing here recurses: parsing, and
+//! dropping a tree, use explicit stacks.
 
 /// An XML element.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -14,6 +16,16 @@ pub(crate) struct Element {
     pub children: Vec<Element>,
     /// The 1-based line of the start tag.
     pub line: usize,
+}
+
+impl Drop for Element {
+    /// Drops the subtree with an explicit stack (a deep tree would overflow the call stack).
+    fn drop(&mut self) {
+        let mut stack = std::mem::take(&mut self.children);
+        while let Some(mut el) = stack.pop() {
+            stack.append(&mut el.children);
+        }
+    }
 }
 
 impl Element {
@@ -121,8 +133,9 @@ impl Reader<'_> {
         let name = self.name()?;
         let mut el = Element {
             name,
+            attrs: Vec::new(),
+            children: Vec::new(),
             line: self.position(tag_start).0,
-            ..Element::default()
         };
         loop {
             self.skip_ws();
@@ -217,6 +230,7 @@ pub(crate) fn parse(text: &str) -> Result<Element, XmlError> {
         pos: 0,
         line_starts,
     };
+    let max_depth = crate::limits::get().max_nesting;
     let mut stack: Vec<Element> = Vec::new();
     let mut root: Option<Element> = None;
     while let Some(i) = r.rest().find('<') {
@@ -268,6 +282,16 @@ pub(crate) fn parse(text: &str) -> Result<Element, XmlError> {
                     }
                 }
             } else {
+                if stack.len() as u64 >= max_depth {
+                    return Err(r.error(
+                        tag_start,
+                        format!(
+                            "<{}> is nested {} elements deep, over the limit max_nesting = {max_depth} (raise it with `emilion run --limit max_nesting=N`)",
+                            el.name,
+                            stack.len() + 1
+                        ),
+                    ));
+                }
                 stack.push(el);
             }
         }
@@ -297,6 +321,29 @@ mod tests {
     }
 
     #[test]
+    fn elements_nested_past_max_nesting_are_an_error_at_their_line() {
+        let deep = format!("<svg>\n{}{}</svg>", "<g>\n".repeat(300), "</g>".repeat(300));
+        let e = parse(&deep).unwrap_err();
+        // the svg is level 1, so the 256th <g> (line 257) is the first too deep
+        assert_eq!(e.line, 257, "{e:?}");
+        assert!(e.message.contains("max_nesting = 256"), "{e:?}");
+        let ok = format!("<svg>{}{}</svg>", "<g>".repeat(255), "</g>".repeat(255));
+        assert!(parse(&ok).is_ok());
+    }
+
+    #[test]
+    fn a_deep_tree_drops_without_recursion() {
+        // deeper than any test thread's stack allows for a recursive drop
+        let mut el = Element::default();
+        for _ in 0..1_000_000 {
+            let mut parent = Element::default();
+            parent.children.push(el);
+            el = parent;
+        }
+        drop(el);
+    }
+
+    #[test]
     fn reports_positions_of_errors() {
         let e = parse("<svg>\n<g>\n</svg>").unwrap_err();
         assert_eq!((e.line, e.column), (3, 1), "{e:?}");
@@ -304,10 +351,8 @@ mod tests {
         assert_eq!(e.line, 2);
         assert!(parse("<svg><g></g>").is_err());
         assert!(parse("").is_err());
-        let el = Element {
-            attrs: vec![("xlink:href".into(), "#n".into())],
-            ..Element::default()
-        };
+        let mut el = Element::default();
+        el.attrs.push(("xlink:href".into(), "#n".into()));
         assert_eq!(el.attr("href"), Some("#n"));
     }
 }
