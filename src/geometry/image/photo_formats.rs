@@ -66,12 +66,28 @@ pub fn photo_with_stem_or(dir: &Path, stem: &str, default_ext: &str) -> PathBuf 
 /// file's content, not its name. An error names the file: missing or unreadable, or "cannot
 /// be decoded as an image" with the formats that can and the decoder's reason.
 pub fn read_photo(path: &Path) -> Result<RgbImage, GeometryError> {
+    let reader = image::ImageReader::open(path).map_err(|e| GeometryError::Image {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    decode_photo_reader(reader, path)
+}
+
+/// [`read_photo`] of a file's bytes already in memory; `path` names it in errors.
+pub fn decode_photo(data: &[u8], path: &Path) -> Result<RgbImage, GeometryError> {
+    decode_photo_reader(image::ImageReader::new(io::Cursor::new(data)), path)
+}
+
+/// Guesses the format from the content and decodes, as [`read_photo`] describes.
+fn decode_photo_reader<R: io::BufRead + io::Seek>(
+    reader: image::ImageReader<R>,
+    path: &Path,
+) -> Result<RgbImage, GeometryError> {
     let err = |message: String| GeometryError::Image {
         path: path.to_path_buf(),
         message,
     };
-    let reader = image::ImageReader::open(path)
-        .map_err(|e| err(e.to_string()))?
+    let reader = reader
         .with_guessed_format()
         .map_err(|e| err(e.to_string()))?;
     let undecodable = |reason: String| {
