@@ -195,6 +195,7 @@ fn work(o: &Options, target: &Target) {
         let peak = alloc::peak().saturating_sub(before);
         if peak > max_peak {
             (max_peak, max_case) = (peak, i);
+            let _ = writeln!(out, "@@ m {peak} {i}");
         }
         if r.is_err() {
             let msg = PANIC.with(|p| p.borrow().replace('\n', " | "));
@@ -246,6 +247,7 @@ fn supervise(o: &Options) {
             .arg("--corpus")
             .arg(&o.corpus)
             .env("RAYON_NUM_THREADS", "1")
+            .env("RUST_BACKTRACE", "0")
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
@@ -273,7 +275,7 @@ fn supervise(o: &Options) {
                 }
                 let mut t = tail_w.lock().unwrap_or_else(|e| e.into_inner());
                 t.extend_from_slice(&buf[..n]);
-                let excess = t.len().saturating_sub(4096);
+                let excess = t.len().saturating_sub(16384);
                 t.drain(..excess);
             }
         });
@@ -298,6 +300,13 @@ fn supervise(o: &Options) {
                             let i: u64 = i.parse().unwrap_or(0);
                             let msg = w.next().unwrap_or("").to_string();
                             record(o, &target, &seeds, &mut findings, i, "panic", &msg);
+                        }
+                        (Some("@@"), Some("m"), Some(peak)) => {
+                            let at: u64 = w.next().and_then(|s| s.parse().ok()).unwrap_or(0);
+                            let peak = peak.parse().unwrap_or(0);
+                            if peak > max_peak {
+                                (max_peak, max_case) = (peak, at);
+                            }
                         }
                         (Some("@@"), Some("end"), Some(peak)) => {
                             if current.is_some() {
@@ -373,12 +382,18 @@ fn progress(target: &Target, done: u64, started: Instant, f: &Findings) {
 
 /// The kind and reason of a worker's death, from its exit status and the end of its stderr.
 fn death(status: Option<std::process::ExitStatus>, stderr: &str) -> (String, String) {
-    let last = stderr
-        .lines()
-        .rev()
-        .find(|l| !l.trim().is_empty())
-        .unwrap_or("")
-        .to_string();
+    let lines: Vec<&str> = stderr.lines().collect();
+    // The panic message (a panic in a thread other than the case's, or while panicking),
+    // else the last line that is not a note.
+    let last = match lines.iter().rposition(|l| l.contains("panicked at")) {
+        Some(k) => lines[k..(k + 2).min(lines.len())].join(" "),
+        None => lines
+            .iter()
+            .rev()
+            .find(|l| !l.trim().is_empty() && !l.starts_with("note:"))
+            .unwrap_or(&"")
+            .to_string(),
+    };
     if let Some(l) = stderr.lines().rev().find(|l| l.contains("memory allocation of")) {
         return ("alloc".into(), l.to_string());
     }

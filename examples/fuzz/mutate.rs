@@ -213,14 +213,8 @@ fn text_mutation(rng: &mut SplitMix64, data: &mut Vec<u8>, dict: &[&str]) -> boo
             }
             let (a, b) = lines[rng.below(lines.len())];
             let line = data[a..b].to_vec();
-            let k = repeat_count(rng);
-            let mut rep = Vec::with_capacity(line.len() * k);
-            for _ in 0..k {
-                rep.extend_from_slice(&line);
-                if rep.len() > MAX_INPUT {
-                    break;
-                }
-            }
+            let k = repeat_count(rng).min(MAX_INPUT / line.len().max(1) + 1);
+            let rep = line.repeat(k);
             data.splice(a..a, rep);
             true
         }
@@ -253,14 +247,8 @@ fn text_mutation(rng: &mut SplitMix64, data: &mut Vec<u8>, dict: &[&str]) -> boo
             let a = rng.below(data.len());
             let k = 1 + rng.below((data.len() - a).min(24));
             let frag = data[a..a + k].to_vec();
-            let times = repeat_count(rng);
-            let mut rep = Vec::new();
-            for _ in 0..times {
-                rep.extend_from_slice(&frag);
-                if rep.len() > MAX_INPUT / 2 {
-                    break;
-                }
-            }
+            let times = repeat_count(rng).min(MAX_INPUT / 2 / frag.len() + 1);
+            let rep = frag.repeat(times);
             data.splice(a..a, rep);
             true
         }

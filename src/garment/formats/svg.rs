@@ -200,7 +200,7 @@ fn units(root: &Element, options: &SvgOptions, path: &Path) -> Result<f64, Patte
             .split(|c: char| c.is_whitespace() || c == ',')
             .filter_map(|s| s.parse().ok())
             .collect();
-        (v.len() == 4 && v[2] > 0.0).then_some(v[2])
+        (v.len() == 4 && v[2] > 0.0).then(|| v[2])
     });
     let width = root.attr("width").and_then(length_mm);
     let mm = match (width, view_w) {
