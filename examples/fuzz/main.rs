@@ -242,7 +242,12 @@ fn supervise(o: &Options) {
         let mut child = Command::new(&exe)
             .args(["--worker", "--reader", target.name])
             .args(["--seed", &o.seed.to_string()])
-            .args(["--start", &next.to_string(), "--cases", &o.cases.to_string()])
+            .args([
+                "--start",
+                &next.to_string(),
+                "--cases",
+                &o.cases.to_string(),
+            ])
             .args(["--max-alloc-mb", &o.max_alloc_mb.to_string()])
             .arg("--corpus")
             .arg(&o.corpus)
@@ -330,7 +335,9 @@ fn supervise(o: &Options) {
                 Ok(Event::Closed) | Err(mpsc::RecvTimeoutError::Disconnected) => {
                     let status = child.wait().ok();
                     std::thread::sleep(Duration::from_millis(50));
-                    let text = String::from_utf8_lossy(&tail.lock().unwrap_or_else(|e| e.into_inner())).to_string();
+                    let text =
+                        String::from_utf8_lossy(&tail.lock().unwrap_or_else(|e| e.into_inner()))
+                            .to_string();
                     let (kind, why) = death(status, &text);
                     let i = current.unwrap_or(next);
                     record(o, &target, &seeds, &mut findings, i, &kind, &why);
@@ -394,7 +401,11 @@ fn death(status: Option<std::process::ExitStatus>, stderr: &str) -> (String, Str
             .unwrap_or(&"")
             .to_string(),
     };
-    if let Some(l) = stderr.lines().rev().find(|l| l.contains("memory allocation of")) {
+    if let Some(l) = stderr
+        .lines()
+        .rev()
+        .find(|l| l.contains("memory allocation of"))
+    {
         return ("alloc".into(), l.to_string());
     }
     if stderr.contains("overflowed its stack") {
@@ -492,8 +503,16 @@ fn write_image_seeds(dir: &Path) {
     std::fs::create_dir_all(dir).expect("the image corpus folder");
     let rgb = RgbImage::from_fn(7, 5, |x, y| Rgb([(x * 36) as u8, (y * 50) as u8, 128]));
     let images = [
-        ("rgb.png", DynamicImage::ImageRgb8(rgb.clone()), ImageFormat::Png),
-        ("gray.png", DynamicImage::ImageRgb8(rgb.clone()).grayscale(), ImageFormat::Png),
+        (
+            "rgb.png",
+            DynamicImage::ImageRgb8(rgb.clone()),
+            ImageFormat::Png,
+        ),
+        (
+            "gray.png",
+            DynamicImage::ImageRgb8(rgb.clone()).grayscale(),
+            ImageFormat::Png,
+        ),
         (
             "rgba16.png",
             DynamicImage::ImageRgba16(image::ImageBuffer::from_fn(3, 4, |x, y| {
@@ -501,12 +520,36 @@ fn write_image_seeds(dir: &Path) {
             })),
             ImageFormat::Png,
         ),
-        ("rgb.jpg", DynamicImage::ImageRgb8(rgb.clone()), ImageFormat::Jpeg),
-        ("rgb.bmp", DynamicImage::ImageRgb8(rgb.clone()), ImageFormat::Bmp),
-        ("rgb.tif", DynamicImage::ImageRgb8(rgb.clone()), ImageFormat::Tiff),
-        ("rgb.tga", DynamicImage::ImageRgb8(rgb.clone()), ImageFormat::Tga),
-        ("rgb.ppm", DynamicImage::ImageRgb8(rgb.clone()), ImageFormat::Pnm),
-        ("rgba.webp", DynamicImage::ImageRgba8(DynamicImage::ImageRgb8(rgb).to_rgba8()), ImageFormat::WebP),
+        (
+            "rgb.jpg",
+            DynamicImage::ImageRgb8(rgb.clone()),
+            ImageFormat::Jpeg,
+        ),
+        (
+            "rgb.bmp",
+            DynamicImage::ImageRgb8(rgb.clone()),
+            ImageFormat::Bmp,
+        ),
+        (
+            "rgb.tif",
+            DynamicImage::ImageRgb8(rgb.clone()),
+            ImageFormat::Tiff,
+        ),
+        (
+            "rgb.tga",
+            DynamicImage::ImageRgb8(rgb.clone()),
+            ImageFormat::Tga,
+        ),
+        (
+            "rgb.ppm",
+            DynamicImage::ImageRgb8(rgb.clone()),
+            ImageFormat::Pnm,
+        ),
+        (
+            "rgba.webp",
+            DynamicImage::ImageRgba8(DynamicImage::ImageRgb8(rgb).to_rgba8()),
+            ImageFormat::WebP,
+        ),
     ];
     for (name, img, format) in images {
         let path = dir.join(name);
