@@ -88,6 +88,7 @@ fn seeds_are_read_as_their_readers_expect() {
     for (reader, file) in [
         ("obj", "square_uv.obj"),
         ("svg", "two_pieces.svg"),
+        ("dxf", "one_piece.dxf"),
         ("pattern", "two_pieces_seam.json"),
         ("fabric", "params_only.json"),
         ("bvh", "two_joints.bvh"),

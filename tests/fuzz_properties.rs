@@ -53,10 +53,10 @@ proptest! {
         prop_assert_eq!(mesh.rest, grid.rest);
     }
 
-    /// Landmarks written as `.pts` (3 decimals) read back within half a thousandth.
+    /// The 68 iBUG landmarks written as `.pts` (3 decimals) read back within half a thousandth.
     #[test]
     fn pts_write_then_read_is_the_same_points(
-        points in proptest::collection::vec((-5000.0f64..5000.0, -5000.0f64..5000.0), 1..80),
+        points in proptest::collection::vec((-5000.0f64..5000.0, -5000.0f64..5000.0), 68),
     ) {
         let points: Vec<[f64; 2]> = points.into_iter().map(|(x, y)| [x, y]).collect();
         let path = scratch(&format!("p{}.pts", points.len()));

@@ -371,7 +371,7 @@ fn supervise(o: &Options) {
         findings.by_signature.len()
     );
     let mut sigs: Vec<_> = findings.by_signature.iter().collect();
-    sigs.sort_by(|a, b| b.1 .0.cmp(&a.1 .0));
+    sigs.sort_by_key(|s| std::cmp::Reverse(s.1 .0));
     for (sig, (n, files)) in sigs {
         eprintln!("  {n:>6} × {sig}\n         saved: {}", files.join(", "));
     }

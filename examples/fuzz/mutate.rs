@@ -223,7 +223,7 @@ fn repeat_count(rng: &mut SplitMix64) -> usize {
 
 fn text_mutation(rng: &mut SplitMix64, data: &mut Vec<u8>, dict: &[&str]) -> bool {
     match rng.below(8) {
-        0 | 1 | 2 => {
+        0..=2 => {
             let spans = number_spans(data);
             if spans.is_empty() {
                 return false;
@@ -352,7 +352,7 @@ fn image_mutation(rng: &mut SplitMix64, data: &mut [u8]) -> bool {
     if data.starts_with(b"\xff\xd8") {
         // JPEG: the first start-of-frame's height and width (big-endian u16)
         let sof = (0..data.len().saturating_sub(9))
-            .find(|&i| data[i] == 0xff && matches!(data[i + 1], 0xc0 | 0xc1 | 0xc2));
+            .find(|&i| data[i] == 0xff && matches!(data[i + 1], 0xc0..=0xc2));
         if let Some(i) = sof {
             let d = dimension(rng).min(65535) as u16;
             let at = i + 5 + 2 * rng.below(2);
