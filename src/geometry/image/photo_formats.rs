@@ -96,6 +96,19 @@ fn open_image(
         .map_err(|e| err(e.to_string()))
 }
 
+/// An image reader on bytes in memory, its format guessed from the content.
+fn memory_image<'a>(
+    data: &'a [u8],
+    path: &Path,
+) -> Result<image::ImageReader<io::Cursor<&'a [u8]>>, GeometryError> {
+    image::ImageReader::new(io::Cursor::new(data))
+        .with_guessed_format()
+        .map_err(|e| GeometryError::Image {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })
+}
+
 fn undecodable(path: &Path, reason: String) -> GeometryError {
     GeometryError::Image {
         path: path.to_path_buf(),
@@ -106,12 +119,12 @@ fn undecodable(path: &Path, reason: String) -> GeometryError {
     }
 }
 
-/// The format and size (pixels) an image file declares in its header, read without decoding
-/// it, after checking the file against `max_file_bytes` and the size against `max_pixels`
-/// ([`check_pixels`]) and that it is not empty. Every image the engine decodes is checked
-/// here first; the error names the file, its size and the limit.
-pub fn check_image_file(path: &Path) -> Result<(image::ImageFormat, u32, u32), GeometryError> {
-    let reader = open_image(path)?;
+/// The format and declared size of the image `reader` holds, checked: a known format, not
+/// empty, within `max_pixels`.
+fn check_header<R: io::BufRead + io::Seek>(
+    reader: image::ImageReader<R>,
+    path: &Path,
+) -> Result<(image::ImageFormat, u32, u32), GeometryError> {
     let Some(format) = reader.format() else {
         return Err(undecodable(path, "unrecognised content".into()));
     };
@@ -128,15 +141,20 @@ pub fn check_image_file(path: &Path) -> Result<(image::ImageFormat, u32, u32), G
     Ok((format, w, h))
 }
 
-/// Reads a photo in any of the [`PHOTO_EXTENSIONS`] formats as 8-bit RGB (grey becomes three
-/// equal channels, alpha is dropped, 16-bit is scaled to 8). The format is taken from the
-/// file's content, not its name; the size its header declares is checked first
-/// ([`check_image_file`]: `max_pixels`). An error names the file: missing or unreadable, too
-/// large, or "cannot be decoded as an image" with the formats that can and the decoder's
-/// reason.
-pub fn read_photo(path: &Path) -> Result<RgbImage, GeometryError> {
-    check_image_file(path)?;
-    let img = open_image(path)?
+/// The format and size (pixels) an image file declares in its header, read without decoding
+/// it, after checking the file against `max_file_bytes` and the size against `max_pixels`
+/// ([`check_pixels`]) and that it is not empty. Every image the engine decodes is checked
+/// here first; the error names the file, its size and the limit.
+pub fn check_image_file(path: &Path) -> Result<(image::ImageFormat, u32, u32), GeometryError> {
+    check_header(open_image(path)?, path)
+}
+
+/// Decodes a checked reader into 8-bit RGB.
+fn decode_rgb<R: io::BufRead + io::Seek>(
+    reader: image::ImageReader<R>,
+    path: &Path,
+) -> Result<RgbImage, GeometryError> {
+    let img = reader
         .decode()
         .map_err(|e| undecodable(path, e.to_string()))?;
     if img.width() == 0 || img.height() == 0 {
@@ -146,6 +164,23 @@ pub fn read_photo(path: &Path) -> Result<RgbImage, GeometryError> {
         ));
     }
     Ok(img.into_rgb8())
+}
+
+/// Reads a photo in any of the [`PHOTO_EXTENSIONS`] formats as 8-bit RGB (grey becomes three
+/// equal channels, alpha is dropped, 16-bit is scaled to 8). The format is taken from the
+/// file's content, not its name; the size its header declares is checked first
+/// ([`check_image_file`]: `max_pixels`). An error names the file: missing or unreadable, too
+/// large, or "cannot be decoded as an image" with the formats that can and the decoder's
+/// reason.
+pub fn read_photo(path: &Path) -> Result<RgbImage, GeometryError> {
+    check_image_file(path)?;
+    decode_rgb(open_image(path)?, path)
+}
+
+/// [`read_photo`] of a file's bytes already in memory; `path` names it in errors.
+pub fn decode_photo(data: &[u8], path: &Path) -> Result<RgbImage, GeometryError> {
+    check_header(memory_image(data, path)?, path)?;
+    decode_rgb(memory_image(data, path)?, path)
 }
 
 #[cfg(test)]

@@ -9,6 +9,7 @@ mod read;
 mod write;
 
 pub use read::{
-    obj_polygons_from_text, obj_surface_from_text, read_obj, read_obj_surface, ObjFace, ObjPolygons,
+    obj_mesh_from_text, obj_polygons_from_text, obj_surface_from_text, read_obj, read_obj_surface,
+    ObjFace, ObjPolygons,
 };
 pub use write::{write_obj, write_obj_mesh, ObjGroup, ObjMesh};

@@ -23,8 +23,18 @@ use crate::geometry::{GeometryError, TriMesh, Vec3};
 /// on malformed numbers or faces, out-of-range indices, face corners without texture
 /// coordinates, zero-area rest triangles, a file without faces, or an otherwise invalid mesh.
 pub fn read_obj(path: &Path) -> Result<TriMesh, GeometryError> {
+    let text = crate::limits::read_to_string(path).map_err(|source| GeometryError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    obj_mesh_from_text(&text, path)
+}
+
+/// [`read_obj`] of OBJ text already in memory; `path` names it in errors.
+pub fn obj_mesh_from_text(text: &str, path: &Path) -> Result<TriMesh, GeometryError> {
     let err = |line: usize, message: String| parse_error(path, line, message);
-    let (mesh, face_lines) = read_and_parse(path, true)?;
+    let (mesh, face_lines) =
+        parse(text, true).map_err(|(line, message)| parse_error(path, line, message))?;
     if mesh.triangles.is_empty() {
         return Err(err(
             0,
@@ -77,15 +87,6 @@ fn parse_error(path: &Path, line: usize, message: String) -> GeometryError {
         line,
         message,
     }
-}
-
-/// Reads and parses `path` (see [`parse`]), errors naming the file and line.
-fn read_and_parse(path: &Path, need_uv: bool) -> Result<(TriMesh, Vec<usize>), GeometryError> {
-    let text = crate::limits::read_to_string(path).map_err(|source| GeometryError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    parse(&text, need_uv).map_err(|(line, message)| parse_error(path, line, message))
 }
 
 /// Why texture coordinates are required.
