@@ -94,7 +94,7 @@ impl SimulationParameters {
         if !(self.dt.is_finite() && (MIN_DT..=MAX_DT).contains(&self.dt)) {
             return Err(ClothError::Parameter(format!(
                 "simulation parameter `dt` is {} s, outside the accepted range [{MIN_DT:e}, {MAX_DT}] s",
-                super::runs::short_number(self.dt)
+                short_number(self.dt)
             )));
         }
         if !(self.cg_tolerance.is_finite() && self.cg_tolerance > 0.0) {
@@ -113,5 +113,33 @@ impl SimulationParameters {
             )));
         }
         Ok(())
+    }
+}
+
+/// `x` as a short number: plain between 10⁻⁴ and 10⁹, otherwise in exponent form with at most
+/// six significant digits (`2e300` rather than 301 digits).
+pub(crate) fn short_number(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e9).contains(&x.abs()) {
+        return format!("{x}");
+    }
+    let s = format!("{x:.5e}");
+    match s.split_once('e') {
+        Some((m, e)) if m.contains('.') => {
+            format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.'))
+        }
+        _ => s,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn short_numbers() {
+        use super::short_number;
+        assert_eq!(short_number(2.0 / 1e-300), "2e300");
+        assert_eq!(short_number(1.2e11), "1.2e11");
+        assert_eq!(short_number(1e-300), "1e-300");
+        assert_eq!(short_number(0.5), "0.5");
+        assert_eq!(short_number(-3.25e-9), "-3.25e-9");
     }
 }

@@ -2,6 +2,7 @@
 //! stated limits (`max_steps`) before anything runs, and stopped when the run is cancelled or
 //! past its deadline.
 
+use super::parameters::short_number;
 use super::simulation::Simulation;
 use super::stats::StepStats;
 use super::ClothError;
@@ -12,21 +13,6 @@ const STATS_RESERVE_MAX: u64 = 1 << 16;
 
 fn limit_err(e: LimitError) -> ClothError {
     ClothError::Parameter(e.to_string())
-}
-
-/// `x` as a short number: plain between 10⁻⁴ and 10⁹, otherwise in exponent form with at most
-/// six significant digits (`2e300` rather than 301 digits).
-pub(crate) fn short_number(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() || (1e-4..1e9).contains(&x.abs()) {
-        return format!("{x}");
-    }
-    let s = format!("{x:.5e}");
-    match s.split_once('e') {
-        Some((m, e)) if m.contains('.') => {
-            format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.'))
-        }
-        _ => s,
-    }
 }
 
 impl Simulation {
@@ -86,18 +72,5 @@ impl Simulation {
             }));
         }
         limits::check(&what(), steps, "max_steps", max).map_err(limit_err)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn short_numbers() {
-        use super::short_number;
-        assert_eq!(short_number(2.0 / 1e-300), "2e300");
-        assert_eq!(short_number(1.2e11), "1.2e11");
-        assert_eq!(short_number(1e-300), "1e-300");
-        assert_eq!(short_number(0.5), "0.5");
-        assert_eq!(short_number(-3.25e-9), "-3.25e-9");
     }
 }
