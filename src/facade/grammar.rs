@@ -12,7 +12,6 @@
 use std::collections::BTreeMap;
 
 use super::labels::Class;
-use super::rule_file::check_shapes;
 
 /// A rectangle in facade units (pixels of the rectified photo at the parse's own size),
 /// y down: `[x0, x1) × [y0, y1)`.
@@ -343,6 +342,20 @@ impl Grammar {
             }
         }
         Ok(())
+    }
+}
+
+/// Checks that a derivation that has made `made` shapes may make `more` (a float: a repeat's
+/// tile count before it is rounded to an integer) without passing the `max_elements` limit;
+/// `rule` names the rule in the error.
+pub fn check_shapes(rule: &str, made: usize, more: f64, max: u64) -> Result<(), String> {
+    let total = made as f64 + more;
+    if total.is_finite() && total <= max as f64 {
+        Ok(())
+    } else {
+        Err(format!(
+            "rule {rule}: the derivation makes {total:.0} shapes or more, over the limit max_elements = {max} (raise it with `emilion run --limit max_elements=N`)"
+        ))
     }
 }
 

@@ -2,7 +2,8 @@
 //! its reading from a file as input, within stated bounds. Every number of a rule file (the
 //! axiom's size, fixed sizes, floating weights, repeat sizes) is finite, ≥ 0 and at most
 //! [`MAX_FACADE_UNITS`] (the axiom's size and repeat sizes > 0); a derivation makes at most
-//! `max_elements` shapes ([`check_shapes`], counted before they are made); a generated facade
+//! `max_elements` shapes ([`check_shapes`](super::grammar::check_shapes), counted before
+//! they are made); a generated facade
 //! is at most [`MAX_FACADE_METRES`] wide and high ([`check_extent`]). Errors name the file and
 //! the line ([`read_rules`]).
 
@@ -43,20 +44,6 @@ fn shown(v: f64) -> String {
         format!("{v:e}")
     } else {
         format!("{v}")
-    }
-}
-
-/// Checks that a derivation that has made `made` shapes may make `more` (a float: a repeat's
-/// tile count before it is rounded to an integer) without passing the `max_elements` limit;
-/// `rule` names the rule in the error.
-pub fn check_shapes(rule: &str, made: usize, more: f64, max: u64) -> Result<(), String> {
-    let total = made as f64 + more;
-    if total.is_finite() && total <= max as f64 {
-        Ok(())
-    } else {
-        Err(format!(
-            "rule {rule}: the derivation makes {total:.0} shapes or more, over the limit max_elements = {max} (raise it with `emilion run --limit max_elements=N`)"
-        ))
     }
 }
 

@@ -413,6 +413,34 @@ pub fn parse_fabric(text: &str, file: &str) -> Result<FabricSpec, KesError> {
     })
 }
 
+/// Checks every value of a fabric (built in code or read) against the ranges of real fabrics;
+/// the error gives the field path as the file format names it (`kes.warp.B`, `weight`) and
+/// the message.
+pub fn check_ranges(spec: &FabricSpec) -> Result<(), (String, String)> {
+    let kes = |q: Quantity, si: f64| q.kes_unit().from_si(si);
+    let field =
+        |f: &str, r: ranges::Range, v: f64| r.check(v).map(|_| ()).map_err(|m| (f.to_string(), m));
+    field(
+        "weight",
+        ranges::WEIGHT,
+        kes(Quantity::ArealWeight, spec.density),
+    )?;
+    if let Some(t) = spec.thickness {
+        field("thickness", ranges::THICKNESS, kes(Quantity::Thickness, t))?;
+    }
+    for (name, d) in [("warp", &spec.warp), ("weft", &spec.weft)] {
+        for (p, v) in &d.values {
+            let f = format!("kes.{name}.{}", p.name());
+            field(&f, ranges::param_range(*p), units::to_kes(*p, *v).1)?;
+        }
+    }
+    field(
+        "protocol.tensile_fm",
+        ranges::TENSILE_FM,
+        kes(Quantity::ForcePerWidth, spec.tensile_fm),
+    )
+}
+
 /// Reads a fabric file.
 pub fn read_fabric(path: &Path) -> Result<FabricSpec, KesError> {
     let file = path.display().to_string();

@@ -206,7 +206,7 @@ fn kes_units(p: KesParam, si: f64) -> (String, String, f64) {
 
 /// Runs the lab on one fabric.
 pub fn run_fabric(spec: &FabricSpec, opts: &LabOptions) -> Result<FabricReport, String> {
-    super::ranges::check_spec(spec)
+    super::fabric::check_ranges(spec)
         .map_err(|(field, m)| format!("{}: field `{field}`: {m}", display_path(spec)))?;
     let meas = measurements(spec);
     let mut model = LawModel::new(&meas).map_err(|e| format!("{}: {e}", display_path(spec)))?;

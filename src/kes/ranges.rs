@@ -11,9 +11,7 @@
 //! RT 73–78 %, G 0.5–0.65 gf/(cm·deg), 2HG5 0.8–1.5 gf/cm), §3 (the definitions: LT, LC ≤ 1,
 //! RT, RC ≤ 100 %), and the ten Wang 2011 fabrics (weight 113–324 g/m²).
 
-use super::fabric::FabricSpec;
 use super::kes_param::KesParam;
-use super::units::{self, Quantity};
 
 /// A closed range `[lo, hi]`, or `(lo, hi]` when `lo_open`, in a parameter's KES unit.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -118,29 +116,6 @@ pub const THICKNESS: Range = Range::open_below(0.0, 20.0, "mm");
 
 /// Maximum load of a tensile protocol: above 0, at most 5000 gf/cm (ten times the standard).
 pub const TENSILE_FM: Range = Range::open_below(0.0, 5000.0, "gf/cm");
-
-/// Checks every value of a fabric (built in code or read) against the ranges of real fabrics;
-/// the error gives the field path as the file format names it (`kes.warp.B`, `weight`) and
-/// the message.
-pub fn check_spec(spec: &FabricSpec) -> Result<(), (String, String)> {
-    let kes = |q: Quantity, si: f64| q.kes_unit().from_si(si);
-    let field = |f: &str, r: Range, v: f64| r.check(v).map(|_| ()).map_err(|m| (f.to_string(), m));
-    field("weight", WEIGHT, kes(Quantity::ArealWeight, spec.density))?;
-    if let Some(t) = spec.thickness {
-        field("thickness", THICKNESS, kes(Quantity::Thickness, t))?;
-    }
-    for (name, d) in [("warp", &spec.warp), ("weft", &spec.weft)] {
-        for (p, v) in &d.values {
-            let f = format!("kes.{name}.{}", p.name());
-            field(&f, param_range(*p), units::to_kes(*p, *v).1)?;
-        }
-    }
-    field(
-        "protocol.tensile_fm",
-        TENSILE_FM,
-        kes(Quantity::ForcePerWidth, spec.tensile_fm),
-    )
-}
 
 #[cfg(test)]
 mod tests {
