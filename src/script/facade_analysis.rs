@@ -8,7 +8,7 @@ use rhai::{Array, Dynamic, Map, INT};
 
 use super::convert::{finite, rt_err, RResult};
 use super::facade::Labels;
-use super::paths::{resolve, resolve_opt};
+use super::paths::{read_opt, read_path, write_folder};
 use super::{function, getter, modules::ApiBuilder, register};
 use crate::facade::analysis::{analyze, Analysis, Options, Rectify};
 use crate::facade::facade_mesh::MeshParams;
@@ -140,7 +140,7 @@ fn from_rules(rules: &str, out: &str, stem: &str, m: &Map) -> RResult<Array> {
             }
         }
     }
-    let rules = resolve(rules);
+    let rules = read_path(rules)?;
     let name = rules.display();
     let text = std::fs::read_to_string(&rules).map_err(|e| rt_err(format!("{name}: {e}")))?;
     let grammar = Grammar::parse(&text).map_err(|e| rt_err(format!("{name}: {e}")))?;
@@ -148,8 +148,8 @@ fn from_rules(rules: &str, out: &str, stem: &str, m: &Map) -> RResult<Array> {
     let files = write_generated(
         &grammar,
         &params,
-        resolve_opt(texture.as_deref()).as_deref(),
-        &resolve(out),
+        read_opt(texture.as_deref())?.as_deref(),
+        &write_folder(out)?,
         stem,
         &opts,
     )
@@ -161,7 +161,7 @@ fn from_rules(rules: &str, out: &str, stem: &str, m: &Map) -> RResult<Array> {
 }
 
 fn run(path: &str, o: &Options) -> RResult<FacadeAnalysis> {
-    analyze(&resolve(path), o)
+    analyze(&read_path(path)?, o)
         .map(|a| FacadeAnalysis(Arc::new(a)))
         .map_err(|e| rt_err(e.to_string()))
 }
@@ -365,7 +365,7 @@ STEM_labels.png, STEM.cga (the rules) and 3D facades at 1×, 0.75× and 1.5× th
 (STEM_w1.obj/.mtl/.glb, …, textured with the rectified photo) with a render of each
 (STEM_w1.png, …). Returns the paths.",
         |a: &mut FacadeAnalysis, dir: &str, stem: &str| -> RResult<Array> {
-            let files = write_outputs(&a.0, &resolve(dir), stem, &OutputOptions::default())
+            let files = write_outputs(&a.0, &write_folder(dir)?, stem, &OutputOptions::default())
                 .map_err(|e| rt_err(e.to_string()))?;
             Ok(files
                 .into_iter()

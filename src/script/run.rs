@@ -1,13 +1,16 @@
-//! Running a script file: `--set key=value` variables, and errors reported as
-//! `FILE:LINE:COL: message` followed by the offending source line and a caret.
+//! Running a script file: `--set key=value` variables, the [sandbox](super::sandbox), and
+//! errors reported as `FILE:LINE:COL: message` followed by the offending source line and a
+//! caret.
 
 use std::fmt;
 use std::path::Path;
+use std::rc::Rc;
 
 use rhai::{Dynamic, Engine, EvalAltResult, Position, Scope};
 
 use super::build_engine;
-use super::paths::ScriptContext;
+use super::paths::{confine, ScriptContext};
+use super::sandbox::Sandbox;
 
 /// A failed script: where, what, and the source line it points at.
 #[derive(Debug, Clone)]
@@ -57,7 +60,11 @@ impl ScriptError {
         }
         let pos = err.position();
         err.clear_position();
-        let mut message = err.to_string();
+        let mut message = match &err {
+            // stopped by `on_progress`: the reason (`--max-seconds`) is the token
+            EvalAltResult::ErrorTerminated(reason, _) if reason.is_string() => reason.to_string(),
+            _ => err.to_string(),
+        };
         if matches!(err, EvalAltResult::ErrorDataRace(..)) {
             message += " (a callback must not capture the object whose method runs it: inside \
                          `sim.run(.., |t| ..)` use `this` or `t.sim` instead of `sim`)";
@@ -133,12 +140,24 @@ pub fn run_source(
         .map_err(|e| ScriptError::from_rhai(file, source, *e))
 }
 
-/// Runs a script file with a fresh engine, `sets` defined as constants beforehand. Relative
-/// paths in the script are taken from its folder, those given by `sets` from the working
-/// directory (see [`paths`](super::paths)).
+/// Runs a script file with a fresh engine, `sets` defined as constants beforehand, trusted
+/// (no sandbox: the caller is Rust code that chose the script). Relative paths in the script
+/// are taken from its folder, those given by `sets` from the working directory (see
+/// [`paths`](super::paths)). `emilion run` uses [`run_file_with`] and the default [`Sandbox`].
 pub fn run_file(path: &Path, sets: &[(String, String)]) -> Result<(), ScriptError> {
+    run_file_with(path, sets, &Sandbox::trusted())
+}
+
+/// [`run_file`] confined by `sandbox`: the script reads and writes only where its rules allow
+/// ([`Sandbox::rules_for_script`]: its folder, the data folder, `out/`, `--set out=DIR`, the
+/// `--set` paths and the sandbox's extra folders).
+pub fn run_file_with(
+    path: &Path,
+    sets: &[(String, String)],
+    sandbox: &Sandbox,
+) -> Result<(), ScriptError> {
     let file = path.display().to_string();
-    let source = std::fs::read_to_string(path).map_err(|e| ScriptError {
+    let source = crate::limits::read_to_string(path).map_err(|e| ScriptError {
         file: file.clone(),
         position: None,
         message: format!("cannot read script: {e}"),
@@ -157,5 +176,6 @@ pub fn run_file(path: &Path, sets: &[(String, String)]) -> Result<(), ScriptErro
         .map(|(_, v)| v.as_str())
         .filter(|v| parse_value(v).is_string());
     let _context = ScriptContext::new(path, strings).enter();
+    let _rules = confine(sandbox.rules_for_script(path, sets).map(Rc::new));
     run_source(&engine, &file, &source, &mut scope)
 }
