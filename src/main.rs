@@ -44,8 +44,9 @@ enum Command {
         /// suffix K, M, G, T: `4G`, `500M`), with an error and exit status 3.
         #[arg(long, value_name = "BYTES", value_parser = parse_memory)]
         max_memory: Option<(u64, String)>,
-        /// Stops the script after this many seconds of wall time with an error; a native call
-        /// that does not stop a few seconds later ends the process with exit status 4.
+        /// Stops the script after this many seconds of wall time with an error (replacing the
+        /// engine's operation limit); a native call that does not stop a few seconds later ends
+        /// the process with exit status 4.
         #[arg(long, value_name = "S", value_parser = run_limits::parse_seconds)]
         max_seconds: Option<f64>,
     },
@@ -184,7 +185,15 @@ fn scripting(cmd: Command) -> anyhow::Result<ExitCode> {
                 emilion::limits::set_deadline(std::time::Duration::from_secs_f64(s));
                 run_limits::start_watchdog(s, &format!("{s}"));
             }
-            if let Err(e) = script::run_file_with(&file, &sets, &sandbox.sandbox()) {
+            let mut options = script::RunOptions {
+                sandbox: sandbox.sandbox(),
+                ..script::RunOptions::default()
+            };
+            if max_seconds.is_some() {
+                // the time limit bounds the run instead of the operation count
+                options.engine.max_operations = 0;
+            }
+            if let Err(e) = script::run_file_with(&file, &sets, &options) {
                 eprintln!("{e}");
                 return Ok(ExitCode::FAILURE);
             }

@@ -139,8 +139,8 @@ fn over_memory(asked: usize, in_use: usize) -> ! {
         EXIT_MEMORY,
         format_args!(
             "error: the script passed its memory limit --max-memory {limit} while allocating \
-             {asked} bytes ({} MiB in use); raise it with --max-memory SIZE\n",
-            in_use >> 20
+             {asked} bytes ({} MiB in use before); raise it with --max-memory SIZE\n",
+            in_use.wrapping_sub(asked) >> 20
         ),
     )
 }

@@ -132,8 +132,8 @@ fn track(seq_dir: &str, out: &str, m: &Map) -> RResult<Map> {
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    let files =
-        write_face_track_outputs(&seq, &result, &write_folder(out)?, overlay_every).map_err(rt_err)?;
+    let files = write_face_track_outputs(&seq, &result, &write_folder(out)?, overlay_every)
+        .map_err(rt_err)?;
     let f = |x: Option<f64>| x.map_or(Dynamic::UNIT, Dynamic::from_float);
     let mut r = Map::new();
     r.insert("frames".into(), Dynamic::from_int(result.rows.len() as INT));

@@ -47,7 +47,7 @@ use rhai::{Dynamic, Engine};
 use modules::ApiBuilder;
 
 pub use fabric::{ClothHandle, Fabric};
-pub use run::{run_file, run_file_with, ScriptError};
+pub use run::{run_file, run_file_with, RunOptions, ScriptError};
 pub use sandbox::Sandbox;
 pub use sim::SimHandle;
 
@@ -101,9 +101,9 @@ macro_rules! function {
 pub(crate) use {function, getter, register};
 
 /// Limits that keep a runaway script from hanging or exhausting memory.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EngineLimits {
-    /// Script operations per run (a native `sim.run` counts as one).
+    /// Script operations per run (a native `sim.run` counts as one); 0: no limit.
     pub max_operations: u64,
     /// Expression nesting depth (global, inside functions).
     pub max_expr_depths: (usize, usize),

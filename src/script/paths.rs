@@ -117,12 +117,13 @@ fn resolve(path: &str) -> PathBuf {
 /// for `access`, as a folder of many files when `folder`.
 fn checked(path: &str, access: Access, folder: bool) -> RResult<PathBuf> {
     let p = resolve(path);
-    RULES.with(|r| match &*r.borrow() {
-        None => Ok(()),
-        Some(rules) if folder => rules.check_folder(&p, access),
-        Some(rules) => rules.check(&p, access),
-    })
-    .map_err(rt_err)?;
+    RULES
+        .with(|r| match &*r.borrow() {
+            None => Ok(()),
+            Some(rules) if folder => rules.check_folder(&p, access),
+            Some(rules) => rules.check(&p, access),
+        })
+        .map_err(rt_err)?;
     Ok(p)
 }
 
@@ -273,13 +274,19 @@ mod tests {
         assert!(read_path("../scripts/a.json").is_ok());
         for bad in ["/etc/passwd", "../../../../../../../../../etc/passwd"] {
             let e = read_path(bad).unwrap_err().to_string();
-            assert!(e.contains("may not read") && e.contains("/etc/passwd"), "{e}");
+            assert!(
+                e.contains("may not read") && e.contains("/etc/passwd"),
+                "{e}"
+            );
         }
         let written = out.join("a/b.png").display().to_string();
         assert!(write_path(&written).is_ok());
         assert!(write_folder(&out.display().to_string()).is_ok());
         let e = write_path("b.png").unwrap_err().to_string();
-        assert!(e.contains("may not write") && e.contains("--allow-write"), "{e}");
+        assert!(
+            e.contains("may not write") && e.contains("--allow-write"),
+            "{e}"
+        );
         {
             let _trusted = confine(None);
             assert!(write_path("b.png").is_ok());

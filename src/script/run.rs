@@ -8,9 +8,9 @@ use std::rc::Rc;
 
 use rhai::{Dynamic, Engine, EvalAltResult, Position, Scope};
 
-use super::build_engine;
 use super::paths::{confine, ScriptContext};
 use super::sandbox::Sandbox;
+use super::{build_engine_with, EngineLimits};
 
 /// A failed script: where, what, and the source line it points at.
 #[derive(Debug, Clone)]
@@ -145,16 +145,31 @@ pub fn run_source(
 /// are taken from its folder, those given by `sets` from the working directory (see
 /// [`paths`](super::paths)). `emilion run` uses [`run_file_with`] and the default [`Sandbox`].
 pub fn run_file(path: &Path, sets: &[(String, String)]) -> Result<(), ScriptError> {
-    run_file_with(path, sets, &Sandbox::trusted())
+    let options = RunOptions {
+        sandbox: Sandbox::trusted(),
+        ..RunOptions::default()
+    };
+    run_file_with(path, sets, &options)
 }
 
-/// [`run_file`] confined by `sandbox`: the script reads and writes only where its rules allow
-/// ([`Sandbox::rules_for_script`]: its folder, the data folder, `out/`, `--set out=DIR`, the
-/// `--set` paths and the sandbox's extra folders).
+/// How [`run_file_with`] runs a script. The default is what `emilion run` does without flags:
+/// the sandbox on, the default engine limits.
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// Where the script may read and write.
+    pub sandbox: Sandbox,
+    /// The engine's limits (`emilion run --max-seconds` lifts the operation count: the time
+    /// limit bounds the run instead).
+    pub engine: EngineLimits,
+}
+
+/// [`run_file`] with `options`: confined by their sandbox, the script reads and writes only
+/// where its rules allow ([`Sandbox::rules_for_script`]: its folder, the data folder, `out/`,
+/// `--set out=DIR`, the `--set` paths and the sandbox's extra folders).
 pub fn run_file_with(
     path: &Path,
     sets: &[(String, String)],
-    sandbox: &Sandbox,
+    options: &RunOptions,
 ) -> Result<(), ScriptError> {
     let file = path.display().to_string();
     let source = crate::limits::read_to_string(path).map_err(|e| ScriptError {
@@ -169,13 +184,13 @@ pub fn run_file_with(
         message,
         source_line: None,
     })?;
-    let engine = build_engine();
+    let engine = build_engine_with(options.engine);
     // the `--set` strings: paths among them are the working directory's
     let strings = sets
         .iter()
         .map(|(_, v)| v.as_str())
         .filter(|v| parse_value(v).is_string());
     let _context = ScriptContext::new(path, strings).enter();
-    let _rules = confine(sandbox.rules_for_script(path, sets).map(Rc::new));
+    let _rules = confine(options.sandbox.rules_for_script(path, sets).map(Rc::new));
     run_source(&engine, &file, &source, &mut scope)
 }

@@ -157,7 +157,12 @@ impl Rules {
         let real = self.check_path(path, access)?;
         let is_root = self.roots(access).iter().any(|(r, _)| *r == real);
         if access == Access::Write && is_root {
-            return Err(refusal(path, Some(&real), access, "a folder the script writes in, not a file"));
+            return Err(refusal(
+                path,
+                Some(&real),
+                access,
+                "a folder the script writes in, not a file",
+            ));
         }
         Ok(())
     }
@@ -308,7 +313,10 @@ mod tests {
     fn normalise_resolves_the_existing_part_and_folds_the_rest() {
         let d = temp("normalise");
         std::fs::create_dir_all(d.join("a/b")).unwrap();
-        assert_eq!(normalise(&d.join("a/b/../c/x.png")).unwrap(), d.join("a/c/x.png"));
+        assert_eq!(
+            normalise(&d.join("a/b/../c/x.png")).unwrap(),
+            d.join("a/c/x.png")
+        );
         assert_eq!(normalise(&d.join("a/new/../../x")).unwrap(), d.join("x"));
         assert_eq!(
             normalise(&d.join("a/b/../../../../../../../../etc/passwd")).unwrap(),
@@ -327,8 +335,13 @@ mod tests {
         let mut rules = Rules::default();
         rules.allow_write(&out, "out/");
         assert!(rules.check(&out.join("a/b.png"), Access::Write).is_ok());
-        let e = rules.check(&out.join("etc/passwd"), Access::Read).unwrap_err();
-        assert!(e.contains("/etc/passwd") && e.contains("may not read"), "{e}");
+        let e = rules
+            .check(&out.join("etc/passwd"), Access::Read)
+            .unwrap_err();
+        assert!(
+            e.contains("/etc/passwd") && e.contains("may not read"),
+            "{e}"
+        );
         let e = rules.check(&out.join("broken"), Access::Write).unwrap_err();
         assert!(e.contains("cannot be resolved"), "{e}");
         assert!(rules
@@ -336,8 +349,13 @@ mod tests {
             .is_err());
         // the folder itself is allowed, a link inside it is not; a file written is inside it
         assert!(rules.check(&out, Access::Write).is_err());
-        assert!(rules.check_folder(&d.join("out/sub"), Access::Write).is_ok());
+        assert!(rules
+            .check_folder(&d.join("out/sub"), Access::Write)
+            .is_ok());
         let e = rules.check_folder(&out, Access::Write).unwrap_err();
-        assert!(e.contains("--allow-write DIR") && e.contains("--trust"), "{e}");
+        assert!(
+            e.contains("--allow-write DIR") && e.contains("--trust"),
+            "{e}"
+        );
     }
 }
