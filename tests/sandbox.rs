@@ -319,3 +319,18 @@ fn the_repl_states_its_sandbox() {
     assert!(stdout.contains("no sandbox"), "{stdout}");
     assert!(!stderr.contains("sandbox: may not"), "{stderr}");
 }
+
+#[test]
+fn the_shipped_scripts_inputs_beside_them_are_copies_of_their_sources() {
+    // the scripts of `scripts/` read only beside themselves and from the data folder (the
+    // sandbox); these inputs are kept there as copies, which must not drift from the originals
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for (copy, source) in [
+        ("scripts/fabrics/shirting-cotton.json", "kawabata/fabrics/shirting-cotton.json"),
+        ("scripts/fabrics/suiting-hesc.json", "kawabata/fabrics/suiting-hesc.json"),
+        ("scripts/faces/astronaut.pts", "tests/data/faces/astronaut.pts"),
+    ] {
+        let read = |p: &str| std::fs::read(root.join(p)).unwrap();
+        assert!(read(copy) == read(source), "{copy} differs from {source}");
+    }
+}
