@@ -326,9 +326,18 @@ fn the_shipped_scripts_inputs_beside_them_are_copies_of_their_sources() {
     // sandbox); these inputs are kept there as copies, which must not drift from the originals
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     for (copy, source) in [
-        ("scripts/fabrics/shirting-cotton.json", "kawabata/fabrics/shirting-cotton.json"),
-        ("scripts/fabrics/suiting-hesc.json", "kawabata/fabrics/suiting-hesc.json"),
-        ("scripts/faces/astronaut.pts", "tests/data/faces/astronaut.pts"),
+        (
+            "scripts/fabrics/shirting-cotton.json",
+            "kawabata/fabrics/shirting-cotton.json",
+        ),
+        (
+            "scripts/fabrics/suiting-hesc.json",
+            "kawabata/fabrics/suiting-hesc.json",
+        ),
+        (
+            "scripts/faces/astronaut.pts",
+            "tests/data/faces/astronaut.pts",
+        ),
     ] {
         let read = |p: &str| std::fs::read(root.join(p)).unwrap();
         assert!(read(copy) == read(source), "{copy} differs from {source}");

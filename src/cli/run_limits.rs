@@ -4,11 +4,12 @@
 //!
 //! Both end the process at once, with a clear message on stderr and their own exit status
 //! ([`EXIT_MEMORY`], [`EXIT_TIME`]): every output file is written atomically, so what was
-//! already written stays whole. The allocator costs an atomic add and a load per allocation.
+//! already written stays whole. Without `--max-memory` the allocator costs one relaxed load and
+//! a branch per allocation; with it, an atomic add besides.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::fmt::Write as _;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering::Relaxed};
+use std::sync::atomic::{AtomicBool, AtomicIsize, Ordering::Relaxed};
 use std::sync::OnceLock;
 use std::time::Duration;
 
@@ -20,21 +21,36 @@ pub const EXIT_TIME: i32 = 4;
 /// The global allocator of the binary: the system's, counting the bytes in use.
 pub struct CountingAlloc;
 
-/// Bytes allocated and not yet freed.
-static IN_USE: AtomicUsize = AtomicUsize::new(0);
-/// The memory limit in bytes (`usize::MAX`: none).
-static LIMIT: AtomicUsize = AtomicUsize::new(usize::MAX);
+/// Whether a limit is set: the bytes are counted only then.
+static COUNTING: AtomicBool = AtomicBool::new(false);
+/// Bytes allocated and not yet freed since the limit was set (negative when more was freed than
+/// allocated since then: the limit is then looser by what was allocated before it, a few KiB
+/// of command-line parsing).
+static IN_USE: AtomicIsize = AtomicIsize::new(0);
+/// The memory limit in bytes.
+static LIMIT: AtomicIsize = AtomicIsize::new(isize::MAX);
 /// The limit as the user wrote it (`4G`), for the message.
 static LIMIT_TEXT: OnceLock<String> = OnceLock::new();
 /// Set by the first thread that ends the process.
 static ENDING: AtomicBool = AtomicBool::new(false);
 
-/// Counts `n` more bytes; past the limit, ends the process.
+/// Counts `n` more bytes when counting; past the limit, ends the process.
 #[inline]
 fn grow(n: usize) {
-    let now = IN_USE.fetch_add(n, Relaxed).wrapping_add(n);
-    if now > LIMIT.load(Relaxed) {
-        over_memory(n, now);
+    if COUNTING.load(Relaxed) {
+        let n = n as isize;
+        let now = IN_USE.fetch_add(n, Relaxed).wrapping_add(n);
+        if now > LIMIT.load(Relaxed) {
+            over_memory(n, now);
+        }
+    }
+}
+
+/// Counts `n` bytes fewer when counting.
+#[inline]
+fn shrink(n: usize) {
+    if COUNTING.load(Relaxed) {
+        IN_USE.fetch_sub(n as isize, Relaxed);
     }
 }
 
@@ -53,7 +69,7 @@ unsafe impl GlobalAlloc for CountingAlloc {
 
     #[inline]
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        IN_USE.fetch_sub(layout.size(), Relaxed);
+        shrink(layout.size());
         System.dealloc(ptr, layout)
     }
 
@@ -62,7 +78,7 @@ unsafe impl GlobalAlloc for CountingAlloc {
         if new_size > layout.size() {
             grow(new_size - layout.size());
         } else {
-            IN_USE.fetch_sub(layout.size() - new_size, Relaxed);
+            shrink(layout.size() - new_size);
         }
         System.realloc(ptr, layout, new_size)
     }
@@ -71,7 +87,8 @@ unsafe impl GlobalAlloc for CountingAlloc {
 /// Sets the memory limit: `bytes`, written `text` by the user.
 pub fn set_max_memory(bytes: u64, text: &str) {
     let _ = LIMIT_TEXT.set(text.to_string());
-    LIMIT.store(usize::try_from(bytes).unwrap_or(usize::MAX), Relaxed);
+    LIMIT.store(isize::try_from(bytes).unwrap_or(isize::MAX), Relaxed);
+    COUNTING.store(true, Relaxed);
 }
 
 /// A message built on the stack (no allocation: it is written from inside the allocator).
@@ -133,14 +150,14 @@ fn exit_now(code: i32) -> ! {
 
 #[cold]
 #[inline(never)]
-fn over_memory(asked: usize, in_use: usize) -> ! {
+fn over_memory(asked: isize, in_use: isize) -> ! {
     let limit = LIMIT_TEXT.get().map_or("", String::as_str);
     end(
         EXIT_MEMORY,
         format_args!(
             "error: the script passed its memory limit --max-memory {limit} while allocating \
              {asked} bytes ({} MiB in use before); raise it with --max-memory SIZE\n",
-            in_use.wrapping_sub(asked) >> 20
+            in_use.wrapping_sub(asked).max(0) >> 20
         ),
     )
 }
