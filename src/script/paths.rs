@@ -266,9 +266,10 @@ mod tests {
         let (dir, out) = (root.join("scripts"), root.join("results"));
         std::fs::create_dir_all(&dir).unwrap();
         let script = dir.join("s.rhai");
-        let sets = [("out".to_string(), out.display().to_string())];
+        let out_text = out.display().to_string();
         let _g = ScriptContext::new(&script, []).enter();
-        let rules = super::super::Sandbox::default().rules_for_script(&script, &sets);
+        let sandbox = super::super::sandbox::Sandbox::default();
+        let rules = sandbox.rules_for_script(&script, [("out", out_text.as_str())]);
         let _r = confine(rules.map(Rc::new));
         assert_eq!(read_path("a.json").unwrap(), dir.join("a.json"));
         assert!(read_path("../scripts/a.json").is_ok());

@@ -191,6 +191,11 @@ pub fn run_file_with(
         .map(|(_, v)| v.as_str())
         .filter(|v| parse_value(v).is_string());
     let _context = ScriptContext::new(path, strings).enter();
-    let _rules = confine(options.sandbox.rules_for_script(path, sets).map(Rc::new));
+    let string_sets = sets
+        .iter()
+        .filter(|(_, v)| parse_value(v).is_string())
+        .map(|(k, v)| (k.as_str(), v.as_str()));
+    let rules = options.sandbox.rules_for_script(path, string_sets);
+    let _rules = confine(rules.map(Rc::new));
     run_source(&engine, &file, &source, &mut scope)
 }

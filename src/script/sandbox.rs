@@ -44,9 +44,14 @@ impl Sandbox {
         }
     }
 
-    /// The rules for running the script file `script` with the `--set` values `sets` (`None`
-    /// when trusted). Relative folders are the working directory's.
-    pub fn rules_for_script(&self, script: &Path, sets: &[(String, String)]) -> Option<Rules> {
+    /// The rules for running the script file `script` with `strings`, the `--set` values that
+    /// are strings, as (key, value) (`None` when trusted). Relative folders are the working
+    /// directory's.
+    pub fn rules_for_script<'a>(
+        &self,
+        script: &Path,
+        strings: impl IntoIterator<Item = (&'a str, &'a str)>,
+    ) -> Option<Rules> {
         if self.trusted {
             return None;
         }
@@ -55,8 +60,8 @@ impl Sandbox {
         if let Some(dir) = file.parent() {
             rules.allow_read(dir, "the script's folder");
         }
-        for (key, value) in sets {
-            if value.is_empty() || !super::run::parse_value(value).is_string() {
+        for (key, value) in strings {
+            if value.is_empty() {
                 continue;
             }
             if key == "out" {
