@@ -1,11 +1,18 @@
 //! The `emilion` command: the demo scene (no arguments), `run` a script, the `repl`, API `doc`s
-//! and the `bench` benchmark.
+//! and the `bench` benchmark. A script runs in the sandbox (`--trust` lifts it) and within
+//! `--max-memory` / `--max-seconds` when given ([`run_limits`]).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
+
+#[path = "cli/run_limits.rs"]
+mod run_limits;
+
+#[global_allocator]
+static ALLOCATOR: run_limits::CountingAlloc = run_limits::CountingAlloc;
 
 /// Cloth simulation with measured fabrics, scripted in Rhai.
 #[derive(Parser)]
@@ -31,11 +38,24 @@ enum Command {
         /// defaults in docs/limits.md).
         #[arg(long = "limit", value_name = "NAME=VALUE", value_parser = parse_set)]
         limits: Vec<(String, String)>,
+        #[command(flatten)]
+        sandbox: SandboxArgs,
+        /// Ends the run once it has allocated more than this much memory (bytes, or with a
+        /// suffix K, M, G, T: `4G`, `500M`), with an error and exit status 3.
+        #[arg(long, value_name = "BYTES", value_parser = parse_memory)]
+        max_memory: Option<(u64, String)>,
+        /// Stops the script after this many seconds of wall time with an error (replacing the
+        /// engine's operation limit); a native call that does not stop a few seconds later ends
+        /// the process with exit status 4.
+        #[arg(long, value_name = "S", value_parser = run_limits::parse_seconds)]
+        max_seconds: Option<f64>,
     },
     /// Interactive Rhai prompt with every emilion function.
     Repl {
         /// A script to run first (its variables and functions stay available).
         init: Option<PathBuf>,
+        #[command(flatten)]
+        sandbox: SandboxArgs,
     },
     /// Writes the script API reference (api.md, api.json) into a folder.
     Doc {
@@ -57,6 +77,35 @@ enum Command {
         #[arg(long, default_value_t = 50)]
         frames: u32,
     },
+}
+
+/// The sandbox flags of `run` and `repl` (docs/scripting.md, "Sandbox").
+#[derive(Args)]
+struct SandboxArgs {
+    /// Lifts the sandbox: the script reads and writes whatever you may.
+    #[arg(long)]
+    trust: bool,
+    /// Lets the script write (and read) under DIR too (repeatable).
+    #[arg(long = "allow-write", value_name = "DIR")]
+    allow_write: Vec<PathBuf>,
+    /// Lets the script read under DIR too (repeatable).
+    #[arg(long = "allow-read", value_name = "DIR")]
+    allow_read: Vec<PathBuf>,
+}
+
+#[cfg(feature = "scripting")]
+impl SandboxArgs {
+    fn sandbox(self) -> emilion::script::Sandbox {
+        emilion::script::Sandbox {
+            trusted: self.trust,
+            allow_write: self.allow_write,
+            allow_read: self.allow_read,
+        }
+    }
+}
+
+fn parse_memory(s: &str) -> Result<(u64, String), String> {
+    run_limits::parse_size(s).map(|b| (b, s.trim().to_string()))
 }
 
 fn parse_set(s: &str) -> Result<(String, String), String> {
@@ -110,7 +159,14 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
 fn scripting(cmd: Command) -> anyhow::Result<ExitCode> {
     use emilion::script;
     match cmd {
-        Command::Run { file, sets, limits } => {
+        Command::Run {
+            file,
+            sets,
+            limits,
+            sandbox,
+            max_memory,
+            max_seconds,
+        } => {
             let mut l = emilion::limits::get();
             for (k, v) in &limits {
                 let n: u64 = v
@@ -122,13 +178,28 @@ fn scripting(cmd: Command) -> anyhow::Result<ExitCode> {
                     .map_err(|e| anyhow::anyhow!("--limit: {e}"))?;
             }
             emilion::limits::set(l);
-            if let Err(e) = script::run_file(&file, &sets) {
+            if let Some((bytes, text)) = &max_memory {
+                run_limits::set_max_memory(*bytes, text);
+            }
+            if let Some(s) = max_seconds {
+                emilion::limits::set_deadline(std::time::Duration::from_secs_f64(s));
+                run_limits::start_watchdog(s, &format!("{s}"));
+            }
+            let mut options = script::RunOptions {
+                sandbox: sandbox.sandbox(),
+                ..script::RunOptions::default()
+            };
+            if max_seconds.is_some() {
+                // the time limit bounds the run instead of the operation count
+                options.engine.max_operations = 0;
+            }
+            if let Err(e) = script::run_file_with(&file, &sets, &options) {
                 eprintln!("{e}");
                 return Ok(ExitCode::FAILURE);
             }
         }
-        Command::Repl { init } => {
-            script::repl::repl(init.as_deref()).map_err(anyhow::Error::msg)?
+        Command::Repl { init, sandbox } => {
+            script::repl::repl(init.as_deref(), &sandbox.sandbox()).map_err(anyhow::Error::msg)?
         }
         Command::Doc { out_dir } => {
             for p in script::docs::write_docs(&out_dir)

@@ -132,18 +132,18 @@ fn steps_can_be_undone_from_a_script() {
         .starts_with("landmark_err_iod_pct="));
     // undo with nothing done is an error the script sees
     let script = out.join("undo.rhai");
-    // the script lives in the temporary folder: its relative paths would be taken from there
+    // the script lives in the temporary folder: its relative paths would be taken from there,
+    // and the sandbox lets it read the landmarks given on the command line
     std::fs::write(
         &script,
-        format!(
-            "let f = face_fit_start(data_dir() + \"/images\", #{{ pts: \"{}\" }});\nf.undo();\n",
-            Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("tests/data/faces")
-                .display()
-        ),
+        "let f = face_fit_start(data_dir() + \"/images\", #{ pts: pts });\nf.undo();\n",
     )
     .unwrap();
-    let (ok, _, stderr) = run(script.to_str().unwrap(), &[]);
+    let pts = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/faces");
+    let (ok, _, stderr) = run(
+        script.to_str().unwrap(),
+        &[format!("pts={}", pts.display())],
+    );
     assert!(!ok && stderr.contains("undo.rhai:2"), "{stderr}");
 }
 

@@ -7,7 +7,7 @@ use rhai::{Array, Dynamic, Engine, Map, INT};
 use super::convert::{
     export_frame, finite, index, indices, rt_err, to_map, update_from_map, vec3, RResult,
 };
-use super::paths::{resolve, resolve_opt};
+use super::paths::{read_folder_opt, read_opt, read_path, write_path};
 use super::{register, SimHandle};
 use crate::body::RetargetOptions;
 use crate::cloth::{ClothError, Simulation};
@@ -45,7 +45,7 @@ fn save_body_obj(sim: &Simulation, b: INT, path: &str, frame: ExportFrame) -> RR
         .ok_or_else(|| rt_err(format!("body {b} does not exist ({n} bodies)")))?;
     let (lo, hi) = crate::geometry::mesh::bounds(&sim.state.x);
     let (p, t) = crate::contact::tessellate::body_mesh(body, &lo, &hi);
-    let path = resolve(path);
+    let path = write_path(path)?;
     if let Some(d) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(d).map_err(|e| rt_err(format!("{}: {e}", d.display())))?;
     }
@@ -82,7 +82,7 @@ pub fn register(engine: &mut Engine) {
     register!(engine, "add_obstacle", ["sim: Simulation", "path: String", "int"],
         "Adds a static triangle mesh read from an OBJ file (metres) as a body. Degenerate triangles\nare dropped; a non-manifold or inconsistently wound mesh is an error naming the edge.\nReturns its body index.",
         |h: &mut SimHandle, path: &str| -> RResult<INT> {
-            let path = resolve(path);
+            let path = read_path(path)?;
             let (positions, triangles) = read_obj_surface(&path)?;
             add_body(h, MeshBody::new(&path.display().to_string(), positions, &triangles).map(Body::mesh))
         });
@@ -97,8 +97,8 @@ pub fn register(engine: &mut Engine) {
             let text = |k: &str| -> RResult<Option<String>> {
                 m.get(k).map(|v| v.clone().into_string().map_err(|t| rt_err(format!("`{k}` must be a string, got {t}")))).transpose()
             };
-            let dir = resolve_opt(text("makehuman")?.as_deref()).unwrap_or_else(|| data_path("bodies/makehuman"));
-            let motion = resolve_opt(text("motion")?.as_deref());
+            let dir = read_folder_opt(text("makehuman")?.as_deref())?.unwrap_or_else(|| data_path("bodies/makehuman"));
+            let motion = read_opt(text("motion")?.as_deref())?;
             let mut opt = RetargetOptions::default();
             if let Some(v) = m.get("in_place") {
                 opt.in_place = v.as_bool().map_err(|t| rt_err(format!("`in_place` must be true or false, got {t}")))?;

@@ -9,7 +9,7 @@ use rhai::{Dynamic, Map, Shared, INT};
 use super::convert::{
     count, get_field, num, rt_err, to_map, update_field, update_from_map, RResult,
 };
-use super::paths::resolve;
+use super::paths::read_path;
 use super::{function, getter, modules::ApiBuilder, register};
 use crate::cloth::{ClothModel, FabricParameters};
 use crate::geometry::read_obj;
@@ -173,7 +173,7 @@ pub fn register(engine: &mut ApiBuilder) {
         ["path: String", "fabric: Fabric", "Cloth"],
         "A cloth from an OBJ mesh whose texture coordinates are the flat pattern (m).",
         |path: &str, f: Fabric| -> RResult<ClothHandle> {
-            let mesh = read_obj(&resolve(path))?;
+            let mesh = read_obj(&read_path(path)?)?;
             Ok(ClothHandle(Shared::new(ClothModel::from_mesh(mesh, f.0)?)))
         }
     );

@@ -4,7 +4,7 @@
 use rhai::{Array, Dynamic, Map, INT};
 
 use super::convert::{rt_err, RResult};
-use super::paths::resolve;
+use super::paths::{read_path, write_folder};
 use super::{function, modules::ApiBuilder, register};
 use crate::facade::instances::window_instances;
 use crate::facade::report::{labelled_images, labelled_photo, summarize, write_summary};
@@ -36,7 +36,7 @@ pub fn register(engine: &mut ApiBuilder) {
 `facade::labelled`), whatever its format: `.jpg`, `.png`, `.ppm`, `.tif`, `.bmp`, `.webp`, …
 (`geometry::image::PHOTO_EXTENSIONS`); an error naming it when there is none.",
         |dir: &str, name: &str| -> RResult<String> {
-            labelled_photo(&resolve(dir), name)
+            labelled_photo(&read_path(dir)?, name)
                 .map(|p| p.display().to_string())
                 .map_err(|e| rt_err(e.to_string()))
         }
@@ -49,7 +49,7 @@ pub fn register(engine: &mut ApiBuilder) {
         "Names (file stems, sorted) of the photos in `dir/images` that have a label map
 `dir/labels/NAME.png` (the LabelMeFacade layout).",
         |dir: &str| -> RResult<Array> {
-            let names = labelled_images(&resolve(dir)).map_err(|e| rt_err(e.to_string()))?;
+            let names = labelled_images(&read_path(dir)?).map_err(|e| rt_err(e.to_string()))?;
             Ok(names.into_iter().map(Dynamic::from).collect())
         }
     );
@@ -62,7 +62,7 @@ pub fn register(engine: &mut ApiBuilder) {
 (building), door, background (sky) and ignore (various, car, vegetation, pavement, road).
 A colour outside the dataset's colour map is an error naming the file and the pixel.",
         |path: &str| -> RResult<Labels> {
-            LabelMap::read_labelmefacade(&resolve(path))
+            LabelMap::read_labelmefacade(&read_path(path)?)
                 .map(Labels)
                 .map_err(|e| rt_err(e.to_string()))
         }
@@ -164,7 +164,7 @@ returns #{images, window_iou, f1 (per-image means), pixel_accuracy, pooled_windo
                         .ok_or_else(|| rt_err(format!("reports[{k}] is not a facade report")))
                 })
                 .collect::<RResult<Vec<_>>>()?;
-            let (csv, md) = write_summary(&reports, method, &resolve(out))
+            let (csv, md) = write_summary(&reports, method, &write_folder(out)?)
                 .map_err(|e| rt_err(e.to_string()))?;
             let s = summarize(&reports);
             let mut m = Map::new();

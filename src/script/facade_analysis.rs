@@ -8,7 +8,7 @@ use rhai::{Array, Dynamic, Map, INT};
 
 use super::convert::{finite, rt_err, RResult};
 use super::facade::Labels;
-use super::paths::{resolve, resolve_opt};
+use super::paths::{read_opt, read_path, write_folder};
 use super::{function, getter, modules::ApiBuilder, register};
 use crate::facade::analysis::{analyze, Analysis, Options, Rectify};
 use crate::facade::facade_mesh::MeshParams;
@@ -141,13 +141,13 @@ fn from_rules(rules: &str, out: &str, stem: &str, m: &Map) -> RResult<Array> {
             }
         }
     }
-    let grammar = read_rules(&resolve(rules)).map_err(|e| rt_err(e.to_string()))?;
+    let grammar = read_rules(&read_path(rules)?).map_err(|e| rt_err(e.to_string()))?;
     let params = MeshParams::new(scale, grammar.size);
     let files = write_generated(
         &grammar,
         &params,
-        resolve_opt(texture.as_deref()).as_deref(),
-        &resolve(out),
+        read_opt(texture.as_deref())?.as_deref(),
+        &write_folder(out)?,
         stem,
         &opts,
     )
@@ -159,7 +159,7 @@ fn from_rules(rules: &str, out: &str, stem: &str, m: &Map) -> RResult<Array> {
 }
 
 fn run(path: &str, o: &Options) -> RResult<FacadeAnalysis> {
-    analyze(&resolve(path), o)
+    analyze(&read_path(path)?, o)
         .map(|a| FacadeAnalysis(Arc::new(a)))
         .map_err(|e| rt_err(e.to_string()))
 }
@@ -363,7 +363,7 @@ STEM_labels.png, STEM.cga (the rules) and 3D facades at 1×, 0.75× and 1.5× th
 (STEM_w1.obj/.mtl/.glb, …, textured with the rectified photo) with a render of each
 (STEM_w1.png, …). Returns the paths.",
         |a: &mut FacadeAnalysis, dir: &str, stem: &str| -> RResult<Array> {
-            let files = write_outputs(&a.0, &resolve(dir), stem, &OutputOptions::default())
+            let files = write_outputs(&a.0, &write_folder(dir)?, stem, &OutputOptions::default())
                 .map_err(|e| rt_err(e.to_string()))?;
             Ok(files
                 .into_iter()

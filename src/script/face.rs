@@ -7,7 +7,9 @@ use indicatif::ProgressBar;
 use rhai::{Dynamic, Map, INT};
 
 use super::convert::{rt_err, RResult};
-use super::paths::{resolve, resolve_opt, resolve_text};
+use super::paths::{
+    read_folder, read_folder_opt, read_folder_text, read_text, write_folder, write_path,
+};
 use super::tracking_sequence::{number, whole};
 use super::{function, modules::ApiBuilder, register};
 use crate::face::adapt::AdaptOptions;
@@ -44,9 +46,9 @@ fn sequence_options(m: &Map) -> RResult<FaceSequenceOptions> {
             "light" => o.light = number(v, k)?,
             "texture_size" => o.texture_size = whole(v, k)? as usize,
             "seed" => o.seed = whole(v, k)?,
-            "texture" => o.texture = Some(resolve_text(&v.to_string())),
-            "model" => o.model = Some(resolve_text(&v.to_string())),
-            "backgrounds" => o.backgrounds = Some(resolve_text(&v.to_string())),
+            "texture" => o.texture = Some(read_text(&v.to_string())?),
+            "model" => o.model = Some(read_text(&v.to_string())?),
+            "backgrounds" => o.backgrounds = Some(read_folder_text(&v.to_string())?),
             "faps" => {
                 let arr = v
                     .read_lock::<rhai::Array>()
@@ -70,7 +72,7 @@ fn sequence_options(m: &Map) -> RResult<FaceSequenceOptions> {
 
 fn make(out: &str, m: &Map) -> RResult<Map> {
     let o = sequence_options(m)?;
-    let info = make_face_sequence(&resolve(out), &o).map_err(rt_err)?;
+    let info = make_face_sequence(&write_folder(out)?, &o).map_err(rt_err)?;
     let mut r = Map::new();
     r.insert("frames".into(), Dynamic::from_int(info.frames as INT));
     r.insert(
@@ -116,7 +118,7 @@ fn track(seq_dir: &str, out: &str, m: &Map) -> RResult<Map> {
             }
         }
     }
-    let seq = FaceSequence::open(&resolve(seq_dir)).map_err(rt_err)?;
+    let seq = FaceSequence::open(&read_folder(seq_dir)?).map_err(rt_err)?;
     let total = frames.map_or(seq.info.frames, |f| f.min(seq.info.frames));
     let bar = std::io::stderr()
         .is_terminal()
@@ -130,8 +132,8 @@ fn track(seq_dir: &str, out: &str, m: &Map) -> RResult<Map> {
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    let files =
-        write_face_track_outputs(&seq, &result, &resolve(out), overlay_every).map_err(rt_err)?;
+    let files = write_face_track_outputs(&seq, &result, &write_folder(out)?, overlay_every)
+        .map_err(rt_err)?;
     let f = |x: Option<f64>| x.map_or(Dynamic::UNIT, Dynamic::from_float);
     let mut r = Map::new();
     r.insert("frames".into(), Dynamic::from_int(result.rows.len() as INT));
@@ -158,7 +160,7 @@ fn expression_png(path: &str, m: &Map, yaw_deg: f64) -> RResult<()> {
         .map(|(k, v)| Ok((k.to_string(), number(v, k)?)))
         .collect::<RResult<Vec<_>>>()?;
     let img = expression_image(&values, 512, yaw_deg).map_err(rt_err)?;
-    let path = resolve(path);
+    let path = write_path(path)?;
     parent_dir(&path)?;
     img.save(&path)
         .map_err(|e| rt_err(format!("{}: {e}", path.display())))
@@ -168,7 +170,7 @@ fn arkit(path: &str) -> RResult<()> {
     let mesh = FaceMesh::mediapipe().map_err(rt_err)?;
     let faps = FapRig::new(&mesh).map_err(rt_err)?;
     let muscles = MuscleRig::mediapipe(&mesh).map_err(rt_err)?;
-    let path = resolve(path);
+    let path = write_path(path)?;
     parent_dir(&path)?;
     write_arkit_glb(&path, &mesh, &faps, &muscles).map_err(rt_err)
 }
@@ -203,9 +205,9 @@ fn fit(images: &str, out: &str, m: &Map) -> RResult<Map> {
         grouping = Grouping::Photo;
     }
     let people = fit_people(
-        &resolve(images),
-        resolve_opt(pts_dir.as_deref()).as_deref(),
-        &resolve(out),
+        &read_folder(images)?,
+        read_folder_opt(pts_dir.as_deref())?.as_deref(),
+        &write_folder(out)?,
         grouping,
         &options,
         texture_size,
@@ -308,8 +310,8 @@ fn start(images: &str, m: &Map) -> RResult<FaceFitSession> {
             }
         }
     }
-    let pts_dir = resolve_opt(pts_dir.as_deref());
-    let photos = load_photos(&resolve(images), pts_dir.as_deref()).map_err(rt_err)?;
+    let pts_dir = read_folder_opt(pts_dir.as_deref())?;
+    let photos = load_photos(&read_folder(images)?, pts_dir.as_deref()).map_err(rt_err)?;
     let generic = FaceMesh::mediapipe().map_err(rt_err)?;
     let fit = FaceFit::new(&generic, &photos.views, &AdaptOptions::default()).map_err(rt_err)?;
     Ok(FaceFitSession { fit, photos })
@@ -512,7 +514,7 @@ textured OBJ and glb, overlays, renders, error map, fit.csv); returns #{images,
 landmark_err_iod_pct, texture_coverage, files}.",
         |s: &mut FaceFitSession, out: &str| -> RResult<Map> {
             let report =
-                write_fit_outputs(&s.fit, &s.photos, &resolve(out), 1024).map_err(rt_err)?;
+                write_fit_outputs(&s.fit, &s.photos, &write_folder(out)?, 1024).map_err(rt_err)?;
             let mut r = Map::new();
             r.insert(
                 "images".into(),

@@ -2,13 +2,14 @@
 //! `Pattern` handle, written back as DXF-AAMA (`save_dxf`), and `garment::dress`, which
 //! meshes, pre-positions and sews a pattern on the mannequin into a `Simulation`.
 
+use std::path::Path;
 use std::sync::Arc;
 
 use rhai::{Map, INT};
 
 use super::convert::{count, num, rt_err, update_from_map, RResult};
 use super::kes::KesFabric;
-use super::paths::resolve;
+use super::paths::{read_folder, read_path, write_path};
 use super::{function, modules::ApiBuilder, register, Fabric, SimHandle};
 use crate::body::Mannequin;
 use crate::cloth::{FabricParameters, MaterialLaw, SimulationParameters};
@@ -25,11 +26,10 @@ fn perr(e: PatternError) -> Box<rhai::EvalAltResult> {
     rt_err(e.to_string())
 }
 
-/// Reads a pattern by its file's extension.
-/// A relative `path` is taken from the running script's folder.
-fn read_any(path: &str) -> Result<Pattern, PatternError> {
-    let file = resolve(path);
-    let p = file.as_path();
+/// Reads a pattern by its file's extension: `path` as the script gave it, `file` where it
+/// leads ([`read_path`]).
+fn read_any(path: &str, file: &Path) -> Result<Pattern, PatternError> {
+    let p = file;
     if path.ends_with(".garment.json") {
         read_garment(p)
     } else if path.ends_with(".json") {
@@ -45,6 +45,27 @@ fn read_any(path: &str) -> Result<Pattern, PatternError> {
     }
 }
 
+/// Checks that the SVG a garment table (`*.garment.json`) names may be read too (the sandbox);
+/// other files, and tables that cannot be read, are left to the reader.
+fn garment_svg_allowed(file: &Path) -> RResult<()> {
+    if !file.to_string_lossy().ends_with(".garment.json") {
+        return Ok(());
+    }
+    let Ok(text) = crate::limits::read_to_string(file) else {
+        return Ok(());
+    };
+    let svg = serde_json::from_str::<serde_json::Value>(&text)
+        .ok()
+        .and_then(|v| v.get("svg")?.as_str().map(str::to_string));
+    if let Some(svg) = svg {
+        // `file` is absolute or the working directory's, so the SVG's path is made absolute
+        let svg = file.parent().unwrap_or(Path::new("")).join(svg);
+        let svg = std::path::absolute(&svg).unwrap_or(svg);
+        read_path(&svg.to_string_lossy())?;
+    }
+    Ok(())
+}
+
 /// `garment::dress` for both kinds of fabric: a linear one, or a density with a measured law.
 fn dress_on_mannequin(
     pattern: &Pattern,
@@ -53,10 +74,10 @@ fn dress_on_mannequin(
     mut m: Map,
 ) -> RResult<SimHandle> {
     let dir = match m.remove("makehuman") {
-        Some(d) => resolve(
+        Some(d) => read_folder(
             &d.into_string()
                 .map_err(|t| rt_err(format!("`makehuman` must be a string, got {t}")))?,
-        ),
+        )?,
         None => crate::geometry::files::data_path("bodies/makehuman"),
     };
     let mut sp = SimulationParameters::default();
@@ -87,7 +108,11 @@ pub fn register(engine: &mut ApiBuilder) {
     engine.register_type_with_name::<PatternHandle>("Pattern");
     function!(engine, "garment::pattern", alias = "garment_pattern", ["path: String", "Pattern"],
         "Reads a sewing pattern: a garment table (`*.garment.json`: an SVG, the parts used, folds,\npairs, placements and seams), a pattern in JSON, an SVG or a DXF-AAMA file. Pieces cut on the\nfold are unfolded and pairs doubled; the pattern is validated (closed, non-crossing outlines,\nmatching seam lengths) with errors naming file, piece and edge.",
-        |path: &str| -> RResult<PatternHandle> { Ok(PatternHandle(Arc::new(read_any(path).map_err(perr)?))) });
+        |path: &str| -> RResult<PatternHandle> { {
+            let file = read_path(path)?;
+            garment_svg_allowed(&file)?;
+            Ok(PatternHandle(Arc::new(read_any(path, &file).map_err(perr)?)))
+        } });
     register!(
         engine,
         "piece_count",
@@ -116,12 +141,12 @@ pub fn register(engine: &mut ApiBuilder) {
     register!(engine, "save_sheet", ["pattern: Pattern", "path: String", "()"],
         "Writes the pattern sheet (`.png` or `.svg`): the pieces side by side at 400 pixels per metre,\nnames, grain lines, notches, and each seam's two edges in its colour with its number.",
         |p: &mut PatternHandle, path: &str| -> RResult<()> {
-            crate::garment::write_pattern_sheet(&resolve(path), &p.0, 400.0).map_err(rt_err)
+            crate::garment::write_pattern_sheet(&write_path(path)?, &p.0, 400.0).map_err(rt_err)
         });
     register!(engine, "save_dxf", ["pattern: Pattern", "path: String", "()"],
         "Writes the pattern as a DXF-AAMA file (ASCII DXF R12) in millimetres: one block per piece\nwith its cut line (layer 1), sewing line (14), turn and curve points (2, 3), notches (4),\ngrain line (7), and as annotation text (layer 15) its corner names and placement; the\nseams as `Seam:` annotation texts. `garment::pattern` reads it back into the same pattern.",
         |p: &mut PatternHandle, path: &str| -> RResult<()> {
-            write_pattern_dxf_with(&p.0, &resolve(path), &DxfOptions::default()).map_err(perr)
+            write_pattern_dxf_with(&p.0, &write_path(path)?, &DxfOptions::default()).map_err(perr)
         });
     register!(engine, "save_dxf", ["pattern: Pattern", "path: String", "options: Map", "()"],
         "As `save_dxf(path)` with options: `units` (\"mm\" default, \"cm\", \"m\" or \"in\"; written as\n`$INSUNITS` and the AAMA `Units:` text).",
@@ -142,7 +167,7 @@ pub fn register(engine: &mut ApiBuilder) {
                     }
                 }
             }
-            write_pattern_dxf_with(&p.0, &resolve(path), &options).map_err(perr)
+            write_pattern_dxf_with(&p.0, &write_path(path)?, &options).map_err(perr)
         });
     register!(
         engine,

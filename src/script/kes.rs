@@ -9,7 +9,7 @@ use rhai::{Array, Dynamic, Map};
 
 use super::convert::{num, rt_err, RResult};
 use super::fabric::Fabric;
-use super::paths::resolve;
+use super::paths::{read_folder, read_path, write_folder};
 use super::{function, modules::ApiBuilder, register};
 use crate::kes::calibrate::Tests;
 use crate::kes::damping::{fit_stretch_damping, free_oscillation, DecayExperiment};
@@ -126,7 +126,7 @@ pub fn register(engine: &mut ApiBuilder) {
     function!(engine, "kes::fabric", alias = "kes_fabric", ["path: String", "KesFabric"],
         "Reads a fabric file (format `emilion-fabric-1`, see kawabata/FORMAT.md). Errors name the\nfile and the field.",
         |path: &str| -> RResult<KesFabric> {
-            Ok(KesFabric(Arc::new(read_fabric(&resolve(path)).map_err(rt_err)?)))
+            Ok(KesFabric(Arc::new(read_fabric(&read_path(path)?).map_err(rt_err)?)))
         });
     function!(
         engine,
@@ -135,7 +135,7 @@ pub fn register(engine: &mut ApiBuilder) {
         ["dir: String", "Array"],
         "Reads every `*.json` fabric file of a folder, sorted by name.",
         |dir: &str| -> RResult<Array> {
-            Ok(read_fabric_dir(&resolve(dir))
+            Ok(read_fabric_dir(&read_folder(dir)?)
                 .map_err(rt_err)?
                 .into_iter()
                 .map(|f| Dynamic::from(KesFabric(Arc::new(f))))
@@ -145,7 +145,7 @@ pub fn register(engine: &mut ApiBuilder) {
     function!(engine, "kes::import_wang", alias = "kes_import_wang", ["dir: String", "out_dir: String", "Array"],
         "Converts the Wang 2011 (ARCSim) material files of `dir` into fabric files in `out_dir`;\nreturns the written paths. (Their licence forbids redistribution: convert at run time.)",
         |dir: &str, out: &str| -> RResult<Array> {
-            Ok(paths(wang::import_wang_dir(&resolve(dir), &resolve(out)).map_err(rt_err)?))
+            Ok(paths(wang::import_wang_dir(&read_folder(dir)?, &write_folder(out)?).map_err(rt_err)?))
         });
     register!(
         engine,
@@ -209,7 +209,7 @@ pub fn register(engine: &mut ApiBuilder) {
     register!(engine, "kes_write", ["report: KesReport", "dir: String", "Array"],
         "Writes the report's curves as CSV and plots (PNG, SVG: measured vs simulated, loops\nvisible) into `dir`; returns the paths.",
         |r: &mut KesReport, dir: &str| -> RResult<Array> {
-            Ok(paths(lab::write_fabric_outputs(&r.0, &resolve(dir)).map_err(rt_err)?))
+            Ok(paths(lab::write_fabric_outputs(&r.0, &write_folder(dir)?).map_err(rt_err)?))
         });
     function!(engine, "kes::summary", alias = "kes_summary", ["reports: Array", "dir: String", "Map"],
         "Writes `summary.csv` and `summary.md` (measured vs simulated parameters, curve errors,\ncantilever) for a list of reports; returns #{csv, md, worst_curve_rms_pct,\nworst_param_err_pct, fabrics}.",
@@ -222,7 +222,7 @@ pub fn register(engine: &mut ApiBuilder) {
                         .ok_or_else(|| rt_err("kes_summary: every element must be a KesReport"))
                 })
                 .collect::<RResult<_>>()?;
-            let (csv, md) = lab::write_summary(&rs, &resolve(dir)).map_err(rt_err)?;
+            let (csv, md) = lab::write_summary(&rs, &write_folder(dir)?).map_err(rt_err)?;
             let mut m = Map::new();
             m.insert("csv".into(), csv.display().to_string().into());
             m.insert("md".into(), md.display().to_string().into());

@@ -4,7 +4,7 @@
 use rhai::{Array, Dynamic, Map, INT};
 
 use super::convert::{finite, index, non_negative, rt_err, RResult};
-use super::paths::resolve;
+use super::paths::write_path;
 use super::{function, modules::ApiBuilder, register, SimHandle};
 use crate::cloth::buckling::wrinkles::{compressed_springs, energy_parts, wrinkles_along};
 use crate::geometry::Vec3;
@@ -123,7 +123,7 @@ pub fn register(engine: &mut ApiBuilder) {
                     style,
                 });
             }
-            let stem = resolve(stem);
+            let stem = write_path(stem)?;
             if let Some(d) = stem.parent().filter(|d| !d.as_os_str().is_empty()) {
                 std::fs::create_dir_all(d).map_err(|e| rt_err(format!("{}: {e}", d.display())))?;
             }

@@ -15,7 +15,8 @@
 //! - [`facade`], [`facade_analysis`]: facade label maps, scores and the photo pipeline;
 //! - [`tracking_sequence`], [`tracking`]: synthetic multi-camera sequences and the body tracker;
 //! - [`paths`]: where a script's relative paths lead (its own folder), `script_dir()`,
-//!   `data_dir()`, `out_dir()`;
+//!   `data_dir()`, `out_dir()`; [`sandbox`]: what a script may read and write; [`imports`]:
+//!   `import "module"` through the same rules;
 //! - [`run`], [`repl`], [`docs`]: running a file, the interactive loop, API documentation.
 //!
 //! Big objects cross into Rhai as shared handles (`Shared<Locked<_>>`), never copied per call.
@@ -28,6 +29,7 @@ pub mod facade;
 pub mod facade_analysis;
 pub mod face;
 pub mod garment;
+pub mod imports;
 pub mod kes;
 pub mod measure;
 pub mod modules;
@@ -35,6 +37,7 @@ pub mod output;
 pub mod paths;
 pub mod repl;
 pub mod run;
+pub mod sandbox;
 pub mod sim;
 pub mod tracking;
 pub mod tracking_sequence;
@@ -44,7 +47,8 @@ use rhai::{Dynamic, Engine};
 use modules::ApiBuilder;
 
 pub use fabric::{ClothHandle, Fabric};
-pub use run::{run_file, ScriptError};
+pub use run::{run_file, run_file_with, RunOptions, ScriptError};
+pub use sandbox::Sandbox;
 pub use sim::SimHandle;
 
 /// Registers a documented global function (a method or property of a handle): name, parameter
@@ -97,9 +101,9 @@ macro_rules! function {
 pub(crate) use {function, getter, register};
 
 /// Limits that keep a runaway script from hanging or exhausting memory.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EngineLimits {
-    /// Script operations per run (a native `sim.run` counts as one).
+    /// Script operations per run (a native `sim.run` counts as one); 0: no limit.
     pub max_operations: u64,
     /// Expression nesting depth (global, inside functions).
     pub max_expr_depths: (usize, usize),
@@ -131,8 +135,15 @@ pub fn build_engine() -> Engine {
     build_engine_with(EngineLimits::default())
 }
 
+/// Script operations between two checks of the run's deadline (`--max-seconds`).
+const OPERATIONS_PER_CHECK: u64 = 4096;
+
 /// An engine with every emilion function registered and the given limits. `print` goes to
-/// stdout, `debug` to stderr.
+/// stdout, `debug` to stderr; the run's deadline ([`limits::check_cancelled`]) stops a script
+/// within a few thousand operations; `import` reads modules through the sandbox
+/// ([`imports`]).
+///
+/// [`limits::check_cancelled`]: crate::limits::check_cancelled
 pub fn build_engine_with(limits: EngineLimits) -> Engine {
     let mut engine = ApiBuilder::new(Engine::new());
     engine
@@ -142,6 +153,13 @@ pub fn build_engine_with(limits: EngineLimits) -> Engine {
         .set_max_array_size(limits.max_array_size)
         .set_max_map_size(limits.max_map_size)
         .set_max_call_levels(limits.max_call_levels);
+    engine.on_progress(|ops| {
+        if ops % OPERATIONS_PER_CHECK != 0 {
+            return None;
+        }
+        crate::limits::check_cancelled().err().map(Dynamic::from)
+    });
+    engine.set_module_resolver(imports::ScriptModules);
     engine.on_print(|s| println!("{s}"));
     engine.on_debug(|s, src, pos| match src {
         Some(src) => eprintln!("{src}:{pos:?}: {s}"),

@@ -6,7 +6,7 @@ use std::path::Path;
 use rhai::{Array, Dynamic, Engine, Map, INT};
 
 use super::convert::{arr3, count, export_frame, finite, rt_err, to_map, RResult};
-use super::paths::{resolve, resolve_text};
+use super::paths::{write_path, write_text};
 use super::{register, SimHandle};
 use crate::cloth::{stats, Simulation};
 use crate::contact::recording::{CacheFormat, Recording};
@@ -81,7 +81,7 @@ const BODY_COLOR: [u8; 3] = [206, 196, 178];
 
 /// Renders the cloth's current shape and the collision bodies to a PNG file.
 fn render(sim: &Simulation, path: &str, cam: &LookAtCamera) -> RResult<()> {
-    let path = resolve_text(path);
+    let path = write_text(path)?;
     let path = path.as_str();
     parent_dir(path)?;
     let (lo, hi) = bounds(&sim.state.x);
@@ -107,7 +107,7 @@ fn render(sim: &Simulation, path: &str, cam: &LookAtCamera) -> RResult<()> {
 
 /// Writes the cloth as OBJ in `frame`.
 fn save_obj(s: &Simulation, path: &str, frame: ExportFrame) -> RResult<()> {
-    let path = resolve_text(path);
+    let path = write_text(path)?;
     let path = path.as_str();
     parent_dir(path)?;
     let (x, m) = (&s.state.x, &s.model.mesh);
@@ -117,7 +117,7 @@ fn save_obj(s: &Simulation, path: &str, frame: ExportFrame) -> RResult<()> {
 
 /// Writes the cloth as binary glTF in `frame` (which must be +Y up).
 fn save_glb(s: &Simulation, path: &str, frame: ExportFrame) -> RResult<()> {
-    let path = resolve_text(path);
+    let path = write_text(path)?;
     let path = path.as_str();
     if frame.up != UpAxis::Y {
         return Err(rt_err(format!(
@@ -136,7 +136,7 @@ fn save_glb(s: &Simulation, path: &str, frame: ExportFrame) -> RResult<()> {
 
 /// Starts recording `h` into `path` with `#{format, fps, up, units}` (see `record`).
 fn record(h: &SimHandle, path: &str, m: &Map) -> RResult<()> {
-    let path = resolve_text(path);
+    let path = write_text(path)?;
     let path = path.as_str();
     let mut frame_opts = m.clone();
     let format = match frame_opts.remove("format") {
@@ -286,7 +286,7 @@ pub fn register(engine: &mut Engine) {
         ["sim: Simulation", "path: String"],
         "Writes the statistics of every step as CSV (one line per step).",
         |h: &mut SimHandle, path: &str| -> RResult<()> {
-            Ok(stats::write_csv(&resolve(path), &h.get()?.stats)?)
+            Ok(stats::write_csv(&write_path(path)?, &h.get()?.stats)?)
         }
     );
     register!(
@@ -295,7 +295,7 @@ pub fn register(engine: &mut Engine) {
         ["sim: Simulation", "path: String"],
         "Writes the statistics of every step as a JSON array.",
         |h: &mut SimHandle, path: &str| -> RResult<()> {
-            Ok(stats::write_json(&resolve(path), &h.get()?.stats)?)
+            Ok(stats::write_json(&write_path(path)?, &h.get()?.stats)?)
         }
     );
     register!(

@@ -1,19 +1,25 @@
-//! Where a script's paths lead: a relative path written in a script is taken from the script's
-//! folder, so a script runs from any working directory; a path given on the command line
-//! (`--set key=PATH`, or one a script builds from such a value, like `out + "/a.png"`) is taken
-//! from the working directory, as a shell user expects; code typed at the REPL uses the working
-//! directory. [`resolve`] is the one helper every path-taking script function calls.
+//! Where a script's paths lead, and whether it may use them: a relative path written in a
+//! script is taken from the script's folder, so a script runs from any working directory; a
+//! path given on the command line (`--set key=PATH`, or one a script builds from such a value,
+//! like `out + "/a.png"`) is taken from the working directory, as a shell user expects; code
+//! typed at the REPL uses the working directory. Then the [sandbox](super::sandbox) in force
+//! checks it. Every path-taking script function calls one of [`read_path`], [`write_path`],
+//! [`read_folder`], [`write_folder`] (or their `_opt`/`_text` forms).
 //!
 //! The running script is recorded per thread by [`ScriptContext::enter`] for as long as the
 //! returned guard lives (`run_file`, the REPL's first script); without one, paths are left as
-//! given (the working directory's).
+//! given (the working directory's). The sandbox's rules are recorded likewise by [`confine`];
+//! without rules (`--trust`, a Rust caller of `run_file`), every path is allowed.
 
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
+use std::rc::Rc;
 
 use rhai::ImmutableString;
 
+use super::convert::{rt_err, RResult};
 use super::register;
+use super::sandbox::{Access, Rules};
 use crate::geometry::files::data_dir;
 
 /// The script being run: its folder, its name and the relative paths given on the command line.
@@ -29,6 +35,24 @@ pub struct ScriptContext {
 
 thread_local! {
     static CURRENT: RefCell<Option<ScriptContext>> = const { RefCell::new(None) };
+    static RULES: RefCell<Option<Rc<Rules>>> = const { RefCell::new(None) };
+}
+
+/// Restores the previous sandbox rules when dropped.
+#[must_use = "the rules last as long as the guard"]
+pub struct RulesGuard(Option<Rc<Rules>>);
+
+impl Drop for RulesGuard {
+    fn drop(&mut self) {
+        let previous = self.0.take();
+        RULES.with(|r| *r.borrow_mut() = previous);
+    }
+}
+
+/// Confines this thread's script functions to `rules` (`None`: no sandbox) until the guard
+/// drops.
+pub fn confine(rules: Option<Rc<Rules>>) -> RulesGuard {
+    RulesGuard(RULES.with(|r| std::mem::replace(&mut *r.borrow_mut(), rules)))
 }
 
 /// Restores the previous context when dropped.
@@ -78,7 +102,7 @@ fn working_dir() -> PathBuf {
 /// they are; a relative path that starts with a `--set` value as given (the working
 /// directory's); any other relative path under the running script's folder. Without a running
 /// script (the REPL), as given.
-pub fn resolve(path: &str) -> PathBuf {
+fn resolve(path: &str) -> PathBuf {
     let p = Path::new(path);
     if p.is_absolute() {
         return p.to_path_buf();
@@ -89,14 +113,66 @@ pub fn resolve(path: &str) -> PathBuf {
     })
 }
 
-/// [`resolve`] as text, for options the engine keeps as strings.
-pub fn resolve_text(path: &str) -> String {
-    resolve(path).display().to_string()
+/// The script-given `path` resolved ([`resolve`]) and checked against the sandbox in force
+/// for `access`, as a folder of many files when `folder`.
+fn checked(path: &str, access: Access, folder: bool) -> RResult<PathBuf> {
+    let p = resolve(path);
+    RULES
+        .with(|r| match &*r.borrow() {
+            None => Ok(()),
+            Some(rules) if folder => rules.check_folder(&p, access),
+            Some(rules) => rules.check(&p, access),
+        })
+        .map_err(rt_err)?;
+    Ok(p)
 }
 
-/// [`resolve`] of an optional path.
-pub fn resolve_opt(path: Option<&str>) -> Option<PathBuf> {
-    path.map(resolve)
+/// A file the script reads (or a folder it lists), resolved and checked against the sandbox.
+pub fn read_path(path: &str) -> RResult<PathBuf> {
+    checked(path, Access::Read, false)
+}
+
+/// A file the script writes, resolved and checked against the sandbox (strictly inside a folder
+/// it may write, so files written beside it are too).
+pub fn write_path(path: &str) -> RResult<PathBuf> {
+    checked(path, Access::Write, false)
+}
+
+/// A folder whose files the script reads (photos, a sequence, fabric files): [`read_path`],
+/// and no link inside it may lead where the script may not read.
+pub fn read_folder(path: &str) -> RResult<PathBuf> {
+    checked(path, Access::Read, true)
+}
+
+/// A folder the script writes many files into: [`write_path`], and no link inside it may lead
+/// where the script may not write.
+pub fn write_folder(path: &str) -> RResult<PathBuf> {
+    checked(path, Access::Write, true)
+}
+
+/// [`read_path`] of an optional path.
+pub fn read_opt(path: Option<&str>) -> RResult<Option<PathBuf>> {
+    path.map(read_path).transpose()
+}
+
+/// [`read_folder`] of an optional path.
+pub fn read_folder_opt(path: Option<&str>) -> RResult<Option<PathBuf>> {
+    path.map(read_folder).transpose()
+}
+
+/// [`read_path`] as text, for options the engine keeps as strings.
+pub fn read_text(path: &str) -> RResult<String> {
+    Ok(read_path(path)?.display().to_string())
+}
+
+/// [`read_folder`] as text, for options the engine keeps as strings.
+pub fn read_folder_text(path: &str) -> RResult<String> {
+    Ok(read_folder(path)?.display().to_string())
+}
+
+/// [`write_path`] as text, for writers that take strings.
+pub fn write_text(path: &str) -> RResult<String> {
+    Ok(write_path(path)?.display().to_string())
 }
 
 /// The running script's folder, absolute; the working directory at the REPL.
@@ -182,6 +258,41 @@ mod tests {
         );
         assert_eq!(script_dir(), Path::new("/somewhere/scripts"));
         assert!(out_dir().ends_with("out/walk") && out_dir().is_absolute());
+    }
+
+    #[test]
+    fn the_sandbox_checks_reads_and_writes_after_resolving() {
+        let root = std::env::temp_dir().join(format!("emilion_paths_{}", std::process::id()));
+        let (dir, out) = (root.join("scripts"), root.join("results"));
+        std::fs::create_dir_all(&dir).unwrap();
+        let script = dir.join("s.rhai");
+        let out_text = out.display().to_string();
+        let _g = ScriptContext::new(&script, []).enter();
+        let sandbox = super::super::sandbox::Sandbox::default();
+        let rules = sandbox.rules_for_script(&script, [("out", out_text.as_str())]);
+        let _r = confine(rules.map(Rc::new));
+        assert_eq!(read_path("a.json").unwrap(), dir.join("a.json"));
+        assert!(read_path("../scripts/a.json").is_ok());
+        for bad in ["/etc/passwd", "../../../../../../../../../etc/passwd"] {
+            let e = read_path(bad).unwrap_err().to_string();
+            assert!(
+                e.contains("may not read") && e.contains("/etc/passwd"),
+                "{e}"
+            );
+        }
+        let written = out.join("a/b.png").display().to_string();
+        assert!(write_path(&written).is_ok());
+        assert!(write_folder(&out.display().to_string()).is_ok());
+        let e = write_path("b.png").unwrap_err().to_string();
+        assert!(
+            e.contains("may not write") && e.contains("--allow-write"),
+            "{e}"
+        );
+        {
+            let _trusted = confine(None);
+            assert!(write_path("b.png").is_ok());
+        }
+        assert!(write_path("b.png").is_err(), "the guard restores the rules");
     }
 
     #[test]

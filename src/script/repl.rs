@@ -2,9 +2,12 @@
 //! input (a trailing `\` or unbalanced brackets continue with `...> `), tab completion of the
 //! registered function names (`module::name` included), and one persistent Scope. Results print as `=> value`; errors
 //! print and the loop goes on. On a non-terminal stdin it reads plain lines, without prompts.
+//! The session is confined by the [sandbox](super::sandbox) (`emilion repl --trust` lifts it),
+//! which its banner and its `sandbox` command state.
 
 use std::io::{BufRead, IsTerminal, Write};
 use std::path::{Path, PathBuf};
+use std::rc::Rc;
 
 use rhai::{Dynamic, Engine, Scope, AST};
 use rustyline::completion::Completer;
@@ -14,8 +17,9 @@ use rustyline::hint::Hinter;
 use rustyline::validate::Validator;
 use rustyline::{Context, Editor, Helper};
 
-use super::paths::ScriptContext;
+use super::paths::{confine, ScriptContext};
 use super::run::ScriptError;
+use super::sandbox::{Rules, Sandbox};
 use super::{build_engine, describe, docs, function_names};
 
 const PROMPT: &str = "emilion> ";
@@ -92,11 +96,13 @@ pub fn needs_more(input: &str) -> bool {
     depth > 0 || quote == Some('`')
 }
 
-/// The REPL's state: engine, persistent scope, and the functions defined so far.
+/// The REPL's state: engine, persistent scope, the functions defined so far, and the
+/// sandbox's rules (`None`: trusted).
 pub struct Session {
     engine: Engine,
     scope: Scope<'static>,
     ast: AST,
+    rules: Option<Rc<Rules>>,
 }
 
 /// What to do after a line.
@@ -106,17 +112,41 @@ enum Flow {
 }
 
 impl Session {
-    /// A fresh session with every emilion function registered.
+    /// A fresh session with every emilion function registered, trusted (no sandbox).
     pub fn new() -> Self {
         Session {
             engine: build_engine(),
             scope: Scope::new(),
             ast: AST::empty(),
+            rules: None,
+        }
+    }
+
+    /// A fresh session confined by `sandbox` (its rules for the REPL: the working directory,
+    /// the data folder, `out/`, the folder of the script `init` run first, the extra folders).
+    pub fn with_sandbox(sandbox: &Sandbox, init: Option<&Path>) -> Self {
+        Session {
+            rules: sandbox.rules_for_repl(init).map(Rc::new),
+            ..Session::new()
+        }
+    }
+
+    /// What the session may read and write, in words.
+    pub fn sandbox_text(&self) -> String {
+        match &self.rules {
+            None => "no sandbox (--trust): reads and writes whatever you may".into(),
+            Some(r) => format!(
+                "sandbox: {}
+(`emilion repl --trust` lifts it; `--allow-write DIR` and \
+                 `--allow-read DIR` add a folder)",
+                r.describe().replace('\n', "\nsandbox: ")
+            ),
         }
     }
 
     /// Evaluates `input` in the persistent scope; functions it defines stay available.
     pub fn eval(&mut self, input: &str) -> Result<Dynamic, ScriptError> {
+        let _rules = confine(self.rules.clone());
         let ast = self
             .engine
             .compile_with_scope(&self.scope, input)
@@ -135,8 +165,12 @@ impl Session {
         match cmd {
             "" => return Flow::Continue,
             "quit" | "exit" => return Flow::Quit,
+            "sandbox" => {
+                let _ = writeln!(out, "{}", self.sandbox_text());
+                return Flow::Continue;
+            }
             "help" => {
-                let _ = writeln!(out, "Type Rhai code; `help NAME` shows the docs of the functions whose name starts with NAME\n(`help cloth::` for a module); `quit` or `exit` leaves. Functions:");
+                let _ = writeln!(out, "Type Rhai code; `help NAME` shows the docs of the functions whose name starts with NAME\n(`help cloth::` for a module); `sandbox` says what may be read and written; `quit` or `exit` leaves. Functions:");
                 let _ = write!(out, "{}", docs::help_text(&self.engine, ""));
                 return Flow::Continue;
             }
@@ -171,7 +205,7 @@ impl Session {
     pub fn run_init(&mut self, path: &Path) -> Result<(), ScriptError> {
         let _context = ScriptContext::new(path, []).enter();
         let file = path.display().to_string();
-        let src = std::fs::read_to_string(path).map_err(|e| ScriptError {
+        let src = crate::limits::read_to_string(path).map_err(|e| ScriptError {
             file: file.clone(),
             position: None,
             message: e.to_string(),
@@ -196,9 +230,9 @@ fn history_path() -> PathBuf {
     }
 }
 
-/// Runs the REPL on stdin, after `init` if given.
-pub fn repl(init: Option<&Path>) -> Result<(), String> {
-    let mut session = Session::new();
+/// Runs the REPL on stdin confined by `sandbox`, after `init` if given.
+pub fn repl(init: Option<&Path>, sandbox: &Sandbox) -> Result<(), String> {
+    let mut session = Session::with_sandbox(sandbox, init);
     if let Some(p) = init {
         if let Err(e) = session.run_init(p) {
             eprintln!("{e}");
@@ -232,6 +266,7 @@ pub fn repl(init: Option<&Path>) -> Result<(), String> {
     let hist = history_path();
     let _ = rl.load_history(&hist);
     println!("emilion REPL: type `help` for the functions, `quit` to leave.");
+    println!("{}", session.sandbox_text());
     let mut buf = String::new();
     loop {
         match rl.readline(if buf.is_empty() { PROMPT } else { MORE }) {

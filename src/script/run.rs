@@ -1,13 +1,16 @@
-//! Running a script file: `--set key=value` variables, and errors reported as
-//! `FILE:LINE:COL: message` followed by the offending source line and a caret.
+//! Running a script file: `--set key=value` variables, the [sandbox](super::sandbox), and
+//! errors reported as `FILE:LINE:COL: message` followed by the offending source line and a
+//! caret.
 
 use std::fmt;
 use std::path::Path;
+use std::rc::Rc;
 
 use rhai::{Dynamic, Engine, EvalAltResult, Position, Scope};
 
-use super::build_engine;
-use super::paths::ScriptContext;
+use super::paths::{confine, ScriptContext};
+use super::sandbox::Sandbox;
+use super::{build_engine_with, EngineLimits};
 
 /// A failed script: where, what, and the source line it points at.
 #[derive(Debug, Clone)]
@@ -57,7 +60,11 @@ impl ScriptError {
         }
         let pos = err.position();
         err.clear_position();
-        let mut message = err.to_string();
+        let mut message = match &err {
+            // stopped by `on_progress`: the reason (`--max-seconds`) is the token
+            EvalAltResult::ErrorTerminated(reason, _) if reason.is_string() => reason.to_string(),
+            _ => err.to_string(),
+        };
         if matches!(err, EvalAltResult::ErrorDataRace(..)) {
             message += " (a callback must not capture the object whose method runs it: inside \
                          `sim.run(.., |t| ..)` use `this` or `t.sim` instead of `sim`)";
@@ -133,12 +140,39 @@ pub fn run_source(
         .map_err(|e| ScriptError::from_rhai(file, source, *e))
 }
 
-/// Runs a script file with a fresh engine, `sets` defined as constants beforehand. Relative
-/// paths in the script are taken from its folder, those given by `sets` from the working
-/// directory (see [`paths`](super::paths)).
+/// Runs a script file with a fresh engine, `sets` defined as constants beforehand, trusted
+/// (no sandbox: the caller is Rust code that chose the script). Relative paths in the script
+/// are taken from its folder, those given by `sets` from the working directory (see
+/// [`paths`](super::paths)). `emilion run` uses [`run_file_with`] and the default [`Sandbox`].
 pub fn run_file(path: &Path, sets: &[(String, String)]) -> Result<(), ScriptError> {
+    let options = RunOptions {
+        sandbox: Sandbox::trusted(),
+        ..RunOptions::default()
+    };
+    run_file_with(path, sets, &options)
+}
+
+/// How [`run_file_with`] runs a script. The default is what `emilion run` does without flags:
+/// the sandbox on, the default engine limits.
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// Where the script may read and write.
+    pub sandbox: Sandbox,
+    /// The engine's limits (`emilion run --max-seconds` lifts the operation count: the time
+    /// limit bounds the run instead).
+    pub engine: EngineLimits,
+}
+
+/// [`run_file`] with `options`: confined by their sandbox, the script reads and writes only
+/// where its rules allow ([`Sandbox::rules_for_script`]: its folder, the data folder, `out/`,
+/// `--set out=DIR`, the `--set` paths and the sandbox's extra folders).
+pub fn run_file_with(
+    path: &Path,
+    sets: &[(String, String)],
+    options: &RunOptions,
+) -> Result<(), ScriptError> {
     let file = path.display().to_string();
-    let source = std::fs::read_to_string(path).map_err(|e| ScriptError {
+    let source = crate::limits::read_to_string(path).map_err(|e| ScriptError {
         file: file.clone(),
         position: None,
         message: format!("cannot read script: {e}"),
@@ -150,12 +184,18 @@ pub fn run_file(path: &Path, sets: &[(String, String)]) -> Result<(), ScriptErro
         message,
         source_line: None,
     })?;
-    let engine = build_engine();
+    let engine = build_engine_with(options.engine);
     // the `--set` strings: paths among them are the working directory's
     let strings = sets
         .iter()
         .map(|(_, v)| v.as_str())
         .filter(|v| parse_value(v).is_string());
     let _context = ScriptContext::new(path, strings).enter();
+    let string_sets = sets
+        .iter()
+        .filter(|(_, v)| parse_value(v).is_string())
+        .map(|(k, v)| (k.as_str(), v.as_str()));
+    let rules = options.sandbox.rules_for_script(path, string_sets);
+    let _rules = confine(rules.map(Rc::new));
     run_source(&engine, &file, &source, &mut scope)
 }

@@ -6,7 +6,7 @@ use indicatif::ProgressBar;
 use rhai::{Dynamic, Map, INT};
 
 use super::convert::{count, finite, rt_err, RResult};
-use super::paths::{resolve, resolve_opt};
+use super::paths::{read_folder, read_folder_opt, write_folder};
 use super::{function, modules::ApiBuilder};
 use crate::body::Mannequin;
 use crate::geometry::files::data_path;
@@ -73,8 +73,9 @@ fn options(m: &Map) -> RResult<(TrackerOptions, TrackOutputOptions, Option<Strin
 
 fn track(seq_dir: &str, out: &str, m: &Map) -> RResult<Map> {
     let (options, out_options, makehuman) = options(m)?;
-    let seq = Sequence::open(resolve(seq_dir)).map_err(rt_err)?;
-    let mh = resolve_opt(makehuman.as_deref()).unwrap_or_else(|| data_path("bodies/makehuman"));
+    let seq = Sequence::open(read_folder(seq_dir)?).map_err(rt_err)?;
+    let mh =
+        read_folder_opt(makehuman.as_deref())?.unwrap_or_else(|| data_path("bodies/makehuman"));
     let mannequin = Mannequin::load_makehuman(&mh).map_err(rt_err)?;
     let total = options.frames.map_or(seq.frames, |f| f.min(seq.frames));
     let bar = std::io::stderr()
@@ -89,7 +90,8 @@ fn track(seq_dir: &str, out: &str, m: &Map) -> RResult<Map> {
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    let files = write_track_outputs(&seq, &result, &resolve(out), &out_options).map_err(rt_err)?;
+    let files =
+        write_track_outputs(&seq, &result, &write_folder(out)?, &out_options).map_err(rt_err)?;
     let mut r = Map::new();
     let f = |x: Option<f64>| x.map_or(Dynamic::UNIT, Dynamic::from_float);
     r.insert(

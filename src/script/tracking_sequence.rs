@@ -3,7 +3,7 @@
 use rhai::{Dynamic, Map, FLOAT, INT};
 
 use super::convert::{rt_err, RResult};
-use super::paths::resolve;
+use super::paths::{read_folder, read_path, write_folder};
 use super::{function, modules::ApiBuilder};
 use crate::tracking::sequence::{make_sequence, SequenceOptions, SequenceSummary};
 
@@ -104,9 +104,9 @@ fn options(m: &Map) -> RResult<SequenceOptions> {
                     .into_string()
                     .map_err(|t| rt_err(format!("`{k}` must be a folder path, got {t}")))?;
                 if k == "backgrounds" {
-                    o.backgrounds = resolve(&s);
+                    o.backgrounds = read_folder(&s)?;
                 } else {
-                    o.makehuman = resolve(&s);
+                    o.makehuman = read_folder(&s)?;
                 }
             }
             other => {
@@ -138,7 +138,7 @@ fn summary_map(s: &SequenceSummary) -> Map {
 }
 
 fn run(motion: &str, out: &str, o: &SequenceOptions) -> RResult<Map> {
-    let s = make_sequence(&resolve(motion), &resolve(out), o).map_err(rt_err)?;
+    let s = make_sequence(&read_path(motion)?, &write_folder(out)?, o).map_err(rt_err)?;
     Ok(summary_map(&s))
 }
 
