@@ -7,6 +7,7 @@
 pub mod body;
 pub mod body_pin;
 pub mod ccd;
+pub mod checkpoint;
 pub mod character;
 pub mod collisions;
 pub mod error;
