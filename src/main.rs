@@ -31,6 +31,17 @@ enum Command {
         /// defaults in docs/limits.md).
         #[arg(long = "limit", value_name = "NAME=VALUE", value_parser = parse_set)]
         limits: Vec<(String, String)>,
+        /// Checkpoints the run every EVERY frames of `run_frames` and of a tracking run (steps
+        /// of `run` and `run_steps`), and when each such call ends (docs/checkpoints.md).
+        #[arg(long, value_name = "EVERY")]
+        checkpoint: Option<u64>,
+        /// Where the checkpoint goes (default: the file resumed, else out/<script name>.ckpt).
+        #[arg(long, value_name = "FILE")]
+        checkpoint_file: Option<PathBuf>,
+        /// Resumes a run killed after writing this checkpoint: the script runs again, finished
+        /// calls take their saved end states, the call in progress continues.
+        #[arg(long, value_name = "FILE")]
+        resume: Option<PathBuf>,
     },
     /// Interactive Rhai prompt with every emilion function.
     Repl {
@@ -110,7 +121,14 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
 fn scripting(cmd: Command) -> anyhow::Result<ExitCode> {
     use emilion::script;
     match cmd {
-        Command::Run { file, sets, limits } => {
+        Command::Run {
+            file,
+            sets,
+            limits,
+            checkpoint,
+            checkpoint_file,
+            resume,
+        } => {
             let mut l = emilion::limits::get();
             for (k, v) in &limits {
                 let n: u64 = v
@@ -122,6 +140,15 @@ fn scripting(cmd: Command) -> anyhow::Result<ExitCode> {
                     .map_err(|e| anyhow::anyhow!("--limit: {e}"))?;
             }
             emilion::limits::set(l);
+            let ckpt = script::checkpoint::CheckpointSettings {
+                every: checkpoint.unwrap_or(0),
+                file: checkpoint_file,
+                resume,
+            };
+            if let Err(e) = script::checkpoint::configure(&file, &sets, &ckpt) {
+                eprintln!("error: {e}");
+                return Ok(ExitCode::FAILURE);
+            }
             if let Err(e) = script::run_file(&file, &sets) {
                 eprintln!("{e}");
                 return Ok(ExitCode::FAILURE);

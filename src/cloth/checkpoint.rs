@@ -188,8 +188,13 @@ impl Simulation {
         let json = d.str("attachments")?;
         let attachments: Vec<Attachment> =
             serde_json::from_str(&json).map_err(|e| d.error(format!("attachments: {e}")))?;
-        if attachments.iter().flat_map(|a| &a.particles).any(|&i| i >= n)
-            || attachments.iter().any(|a| a.anchors.len() != a.particles.len())
+        if attachments
+            .iter()
+            .flat_map(|a| &a.particles)
+            .any(|&i| i >= n)
+            || attachments
+                .iter()
+                .any(|a| a.anchors.len() != a.particles.len())
         {
             return Err(d.error("an attachment names a particle the cloth does not have"));
         }

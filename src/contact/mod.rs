@@ -7,8 +7,8 @@
 pub mod body;
 pub mod body_pin;
 pub mod ccd;
-pub mod checkpoint;
 pub mod character;
+pub mod checkpoint;
 pub mod collisions;
 pub mod error;
 pub mod floor;

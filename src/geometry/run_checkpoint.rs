@@ -42,11 +42,11 @@ pub struct RunCheckpoint {
     pub calls: Vec<CallRecord>,
 }
 
-fn encode<'a>(every: u64, calls: impl ExactSizeIterator<Item = &'a CallRecord>) -> Vec<u8> {
+fn encode(every: u64, calls: &[&CallRecord]) -> Vec<u8> {
     let mut e = Encoder::new();
     e.u64(every);
     e.usize(calls.len());
-    for c in calls {
+    for c in calls.iter() {
         e.u64(c.ordinal);
         e.str(&c.kind);
         e.u64(c.fingerprint);
@@ -60,11 +60,11 @@ fn encode<'a>(every: u64, calls: impl ExactSizeIterator<Item = &'a CallRecord>) 
 
 /// Writes a run checkpoint of the calls `calls` (the finished ones, then the one in progress)
 /// for the run of fingerprint `run` (its script and settings), atomically.
-pub fn write_run_checkpoint<'a>(
+pub fn write_run_checkpoint(
     path: &Path,
     run: u64,
     every: u64,
-    calls: impl ExactSizeIterator<Item = &'a CallRecord>,
+    calls: &[&CallRecord],
 ) -> Result<(), GeometryError> {
     checkpoint::write_file(path, RUN_KIND, run, &encode(every, calls))
 }
@@ -121,7 +121,7 @@ mod tests {
                 state: vec![],
             },
         ];
-        write_run_checkpoint(&path, 99, 2, calls.iter()).unwrap();
+        write_run_checkpoint(&path, 99, 2, &calls.iter().collect::<Vec<_>>()).unwrap();
         let (fp, r) = read_run_checkpoint(&path).unwrap();
         assert_eq!((fp, r.every), (99, 2));
         assert_eq!(r.calls, calls);
