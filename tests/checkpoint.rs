@@ -250,7 +250,10 @@ fn a_tracking_run_killed_after_two_frames_resumes_to_the_same_files() {
     let mut first = track("killed");
     first.extend(args(&["--checkpoint", "1", "--checkpoint-file", "t.ckpt"]));
     let line = run_and_kill(&dir, &first, 2);
-    assert!(line.contains("track_body") && line.contains("at 2 "), "{line}");
+    assert!(
+        line.contains("track_body") && line.contains("at 2 "),
+        "{line}"
+    );
     let mut again = track("killed");
     again.extend(args(&["--resume", "t.ckpt"]));
     let err = run_ok(&dir, &again);

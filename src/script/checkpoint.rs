@@ -17,8 +17,6 @@
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use rhai::Array;
-
 use super::convert::{rt_err, RResult};
 use super::paths::resolve;
 use super::{modules::ApiBuilder, register, SimHandle};
@@ -206,7 +204,7 @@ pub fn begin(kind: &'static str, fingerprint: impl FnOnce() -> u64) -> RResult<(
 impl Call {
     /// Whether a checkpoint is due after `progress` frames (or steps) of this call.
     pub fn due(&self, progress: u64) -> bool {
-        self.every > 0 && progress % self.every == 0
+        self.every > 0 && progress.is_multiple_of(self.every)
     }
 
     /// Whether this call is checkpointed at all.
@@ -317,13 +315,4 @@ scene, a damaged file or a format this build does not read is an error naming th
             read_simulation_checkpoint(&p, &mut sim, &mut recs).map_err(|e| rt_err(e.to_string()))
         }
     );
-}
-
-/// The fingerprint of a list of strings and numbers (a tracking call's setup).
-pub fn fingerprint_of(parts: &Array) -> u64 {
-    let mut f = Fingerprint::default();
-    for p in parts {
-        f.str(&p.to_string());
-    }
-    f.value()
 }

@@ -5,17 +5,17 @@ use std::io::IsTerminal;
 use indicatif::ProgressBar;
 use rhai::{Dynamic, Map, INT};
 
-use super::convert::{count, finite, rt_err, RResult};
 use super::checkpoint::{begin, resumed_file, Plan};
+use super::convert::{count, finite, rt_err, RResult};
 use super::paths::{resolve, resolve_opt};
 use super::{function, modules::ApiBuilder};
 use crate::body::Mannequin;
-use crate::geometry::files::data_path;
-use crate::tracking::sequence_files::Sequence;
-use crate::tracking::track_outputs::{arm_joints, write_track_outputs, TrackOutputOptions};
 use crate::geometry::checkpoint::Fingerprint;
+use crate::geometry::files::data_path;
 use crate::tracking::checkpoint::TrackCheckpoint;
+use crate::tracking::sequence_files::Sequence;
 use crate::tracking::sequence_run::track_sequence_from;
+use crate::tracking::track_outputs::{arm_joints, write_track_outputs, TrackOutputOptions};
 use crate::tracking::tracker::{TrackError, TrackerOptions};
 
 fn options(m: &Map) -> RResult<(TrackerOptions, TrackOutputOptions, Option<String>)> {

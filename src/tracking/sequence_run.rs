@@ -10,8 +10,7 @@ use super::joints::{mpjpe, JOINT_COUNT};
 use super::pyramid::Level;
 use super::sequence_files::Sequence;
 use super::tracker::{
-    changing_pixels, sequence_backgrounds, TrackError, TrackResult, Tracker, TrackerOptions,
-    STAGES,
+    changing_pixels, sequence_backgrounds, TrackError, TrackResult, Tracker, TrackerOptions, STAGES,
 };
 use crate::body::Mannequin;
 use crate::geometry::Vec3;
@@ -97,7 +96,9 @@ pub fn track_sequence_from(
         result.params.push(params);
         result.costs.push(cost);
         result.frame_seconds.push(t0.elapsed().as_secs_f64());
-        after(k + 1, frames, &|| TrackCheckpoint::of(&tracker, &result, k + 1))?;
+        after(k + 1, frames, &|| {
+            TrackCheckpoint::of(&tracker, &result, k + 1)
+        })?;
     }
     result.stage_seconds = STAGES
         .iter()

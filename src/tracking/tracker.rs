@@ -27,7 +27,6 @@ use super::puppet_mesh::TrackingMesh;
 use super::pyramid::{median_background, Level};
 use super::restarts::limb_restarts;
 use super::sequence_files::{Sequence, SequenceError};
-pub use super::sequence_run::track_sequence;
 use super::texture::learn_colours;
 use crate::body::Mannequin;
 use crate::geometry::{SplitMix64, Vec3};
