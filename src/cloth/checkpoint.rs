@@ -11,10 +11,11 @@
 //! the code that built it first, and checked by a [fingerprint](Simulation::fingerprint).
 
 use super::elements::SpringKind;
+use super::solver::assembly::Assembly;
 use super::stats::StepStats;
 use super::{Attachment, ClothError, Simulation, SimulationParameters};
 use crate::geometry::checkpoint::{Decoder, Encoder, Fingerprint};
-use crate::geometry::GeometryError;
+use crate::geometry::{GeometryError, Vec3};
 
 fn bad(e: GeometryError) -> ClothError {
     ClothError::Parameter(e.to_string())
@@ -60,6 +61,56 @@ fn load_stats(d: &mut Decoder) -> Result<StepStats, GeometryError> {
         penetrating: d.usize(w)?,
         intersections: d.usize(w)?,
     })
+}
+
+impl Assembly {
+    /// Writes the friction states (committed and trial) into a checkpoint.
+    pub fn save_friction(&self, e: &mut Encoder) {
+        for v in [
+            &self.fric_spring,
+            &self.fric_quad,
+            &self.fric_hinge,
+            &self.trial_spring,
+            &self.trial_quad,
+            &self.trial_hinge,
+        ] {
+            e.f64s(&v.iter().flatten().copied().collect::<Vec<_>>());
+        }
+        for v in [&self.fric_bend, &self.trial_bend] {
+            e.vec3s(&v.iter().flatten().copied().collect::<Vec<_>>());
+        }
+    }
+
+    /// Reads the friction states [`Assembly::save_friction`] wrote.
+    pub fn load_friction(&mut self, d: &mut Decoder) -> Result<(), GeometryError> {
+        let pairs = |d: &mut Decoder, what: &str| -> Result<Vec<[f64; 2]>, GeometryError> {
+            let v = d.f64s(what)?;
+            if v.len() % 2 != 0 {
+                return Err(d.error(format!("{what}: an odd number of values")));
+            }
+            Ok(v.chunks(2).map(|c| [c[0], c[1]]).collect())
+        };
+        self.fric_spring = pairs(d, "spring friction")?;
+        self.fric_quad = pairs(d, "shear friction")?;
+        self.fric_hinge = pairs(d, "hinge friction")?;
+        self.trial_spring = pairs(d, "spring trial friction")?;
+        self.trial_quad = pairs(d, "shear trial friction")?;
+        self.trial_hinge = pairs(d, "hinge trial friction")?;
+        let bends = |d: &mut Decoder, what: &str| -> Result<Vec<[Vec3; 2]>, GeometryError> {
+            let v = d.vec3s(what)?;
+            if v.len() % 2 != 0 {
+                return Err(d.error(format!("{what}: an odd number of values")));
+            }
+            Ok(v.chunks(2).map(|c| [c[0], c[1]]).collect())
+        };
+        self.fric_bend = bends(d, "bending friction")?;
+        self.trial_bend = bends(d, "bending trial friction")?;
+        let (t, c) = (&self.trial_spring, &self.fric_spring);
+        if t.len() != c.len() || self.trial_bend.len() != self.fric_bend.len() {
+            return Err(d.error("friction states of different lengths"));
+        }
+        Ok(())
+    }
 }
 
 /// Bytes of one encoded [`StepStats`].

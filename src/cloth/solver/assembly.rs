@@ -16,8 +16,7 @@ use super::parallel::{chunks, stream_copy, stream_fence, SyncPtr, CHUNK};
 use super::simd::multiversion;
 use crate::cloth::elements::material::Direction;
 use crate::cloth::model::ClothModel;
-use crate::geometry::checkpoint::{Decoder, Encoder};
-use crate::geometry::{GeometryError, Mat3, Vec3};
+use crate::geometry::{Mat3, Vec3};
 
 /// One matrix contribution: `values[slot] += scale · block src`, the scale kept apart (see
 /// [`Assembly`]'s `rec_scale`). Eight bytes, not sixteen: the gather streams one record per
@@ -75,15 +74,15 @@ pub struct Assembly {
     energy_partials: Vec<f64>,
     /// Friction states (committed coordinate, friction force) per element, allocated on the
     /// first assembly with a law that has internal friction; NaN coordinate = not yet seen.
-    fric_spring: Vec<[f64; 2]>,
-    fric_quad: Vec<[f64; 2]>,
-    fric_bend: Vec<[Vec3; 2]>,
-    fric_hinge: Vec<[f64; 2]>,
+    pub(in crate::cloth) fric_spring: Vec<[f64; 2]>,
+    pub(in crate::cloth) fric_quad: Vec<[f64; 2]>,
+    pub(in crate::cloth) fric_bend: Vec<[Vec3; 2]>,
+    pub(in crate::cloth) fric_hinge: Vec<[f64; 2]>,
     /// Trial friction states of the last evaluation (committed by [`Assembly::commit_friction`]).
-    trial_spring: Vec<[f64; 2]>,
-    trial_quad: Vec<[f64; 2]>,
-    trial_bend: Vec<[Vec3; 2]>,
-    trial_hinge: Vec<[f64; 2]>,
+    pub(in crate::cloth) trial_spring: Vec<[f64; 2]>,
+    pub(in crate::cloth) trial_quad: Vec<[f64; 2]>,
+    pub(in crate::cloth) trial_bend: Vec<[Vec3; 2]>,
+    pub(in crate::cloth) trial_hinge: Vec<[f64; 2]>,
     /// Commit the friction states after every assembly (true for time stepping, where every
     /// assembly happens at an accepted state); quasi-static solvers set it false and commit
     /// once an increment has converged.
@@ -533,54 +532,6 @@ impl RowGather<'_> {
 }
 
 impl Assembly {
-    /// Writes the friction states (committed and trial) into a checkpoint.
-    pub fn save_friction(&self, e: &mut Encoder) {
-        for v in [
-            &self.fric_spring,
-            &self.fric_quad,
-            &self.fric_hinge,
-            &self.trial_spring,
-            &self.trial_quad,
-            &self.trial_hinge,
-        ] {
-            e.f64s(&v.iter().flatten().copied().collect::<Vec<_>>());
-        }
-        for v in [&self.fric_bend, &self.trial_bend] {
-            e.vec3s(&v.iter().flatten().copied().collect::<Vec<_>>());
-        }
-    }
-
-    /// Reads the friction states [`Assembly::save_friction`] wrote.
-    pub fn load_friction(&mut self, d: &mut Decoder) -> Result<(), GeometryError> {
-        let pairs = |d: &mut Decoder, what: &str| -> Result<Vec<[f64; 2]>, GeometryError> {
-            let v = d.f64s(what)?;
-            if v.len() % 2 != 0 {
-                return Err(d.error(format!("{what}: an odd number of values")));
-            }
-            Ok(v.chunks(2).map(|c| [c[0], c[1]]).collect())
-        };
-        self.fric_spring = pairs(d, "spring friction")?;
-        self.fric_quad = pairs(d, "shear friction")?;
-        self.fric_hinge = pairs(d, "hinge friction")?;
-        self.trial_spring = pairs(d, "spring trial friction")?;
-        self.trial_quad = pairs(d, "shear trial friction")?;
-        self.trial_hinge = pairs(d, "hinge trial friction")?;
-        let bends = |d: &mut Decoder, what: &str| -> Result<Vec<[Vec3; 2]>, GeometryError> {
-            let v = d.vec3s(what)?;
-            if v.len() % 2 != 0 {
-                return Err(d.error(format!("{what}: an odd number of values")));
-            }
-            Ok(v.chunks(2).map(|c| [c[0], c[1]]).collect())
-        };
-        self.fric_bend = bends(d, "bending friction")?;
-        self.trial_bend = bends(d, "bending trial friction")?;
-        let (t, c) = (&self.trial_spring, &self.fric_spring);
-        if t.len() != c.len() || self.trial_bend.len() != self.fric_bend.len() {
-            return Err(d.error("friction states of different lengths"));
-        }
-        Ok(())
-    }
-
     /// Makes the friction states of the last evaluation the committed ones.
     pub fn commit_friction(&mut self) {
         self.fric_spring.copy_from_slice(&self.trial_spring);
