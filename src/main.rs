@@ -49,6 +49,17 @@ enum Command {
         /// the process with exit status 4.
         #[arg(long, value_name = "S", value_parser = run_limits::parse_seconds)]
         max_seconds: Option<f64>,
+        /// Checkpoints the run every EVERY frames of `run_frames` and of a tracking run (steps
+        /// of `run` and `run_steps`), and when each such call ends (docs/checkpoints.md).
+        #[arg(long, value_name = "EVERY")]
+        checkpoint: Option<u64>,
+        /// Where the checkpoint goes (default: the file resumed, else out/<script name>.ckpt).
+        #[arg(long, value_name = "FILE")]
+        checkpoint_file: Option<PathBuf>,
+        /// Resumes a run killed after writing this checkpoint: the script runs again, finished
+        /// calls take their saved end states, the call in progress continues.
+        #[arg(long, value_name = "FILE")]
+        resume: Option<PathBuf>,
     },
     /// Interactive Rhai prompt with every emilion function.
     Repl {
@@ -166,6 +177,9 @@ fn scripting(cmd: Command) -> anyhow::Result<ExitCode> {
             sandbox,
             max_memory,
             max_seconds,
+            checkpoint,
+            checkpoint_file,
+            resume,
         } => {
             let mut l = emilion::limits::get();
             for (k, v) in &limits {
@@ -192,6 +206,15 @@ fn scripting(cmd: Command) -> anyhow::Result<ExitCode> {
             if max_seconds.is_some() {
                 // the time limit bounds the run instead of the operation count
                 options.engine.max_operations = 0;
+            }
+            let ckpt = script::checkpoint::CheckpointSettings {
+                every: checkpoint.unwrap_or(0),
+                file: checkpoint_file,
+                resume,
+            };
+            if let Err(e) = script::checkpoint::configure(&file, &sets, &ckpt) {
+                eprintln!("error: {e}");
+                return Ok(ExitCode::FAILURE);
             }
             if let Err(e) = script::run_file_with(&file, &sets, &options) {
                 eprintln!("{e}");

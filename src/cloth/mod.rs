@@ -4,6 +4,7 @@
 //! contact takes part in a step, per-step statistics.
 
 pub mod buckling;
+pub mod checkpoint;
 pub mod constraints;
 pub mod elements;
 pub mod error;

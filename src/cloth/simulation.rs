@@ -71,19 +71,19 @@ pub struct Simulation {
     /// Steps whose CG solve did not reach the tolerance.
     pub unconverged_steps: u64,
     /// Share of `params.gravity` acting (a garment's sewing turns it down while it sews).
-    gravity_share: f64,
+    pub(super) gravity_share: f64,
     /// Stages of every step beside the cloth's forces (contact), in the order added.
-    stages: Vec<Box<dyn StepStage>>,
+    pub(super) stages: Vec<Box<dyn StepStage>>,
     filter: Filter,
     z: Vec<Vec3>,
-    dv: Vec<Vec3>,
+    pub(super) dv: Vec<Vec3>,
     x_save: Vec<Vec3>,
     v_save: Vec<Vec3>,
     impulse: Vec<Vec3>,
     x_step: Vec<Vec3>,
-    asm: Assembly,
+    pub(super) asm: Assembly,
     pcg: PcgWorkspace,
-    mg: Option<Multigrid>,
+    pub(super) mg: Option<Multigrid>,
     amg: Option<AggregationMultigrid>,
 }
 

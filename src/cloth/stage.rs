@@ -10,7 +10,8 @@ use std::any::Any;
 use super::constraints::Filter;
 use super::sewing::Sewing;
 use super::stats::StepStats;
-use crate::geometry::Vec3;
+use crate::geometry::checkpoint::{Decoder, Encoder, Fingerprint};
+use crate::geometry::{GeometryError, Vec3};
 
 /// The end of a step as the stages' responses see it.
 #[derive(Debug)]
@@ -78,6 +79,24 @@ pub trait StepStage: Send + Sync + std::fmt::Debug + Any {
     /// none).
     fn crossings(&mut self, _x: &[Vec3]) -> Vec<([u32; 2], [u32; 3])> {
         Vec::new()
+    }
+
+    /// The stage's name in checkpoints (its type's).
+    fn stage_name(&self) -> &'static str {
+        std::any::type_name::<Self>()
+    }
+
+    /// Feeds what a checkpoint of this stage is valid for (its setup: bodies, sizes) into a
+    /// simulation's fingerprint (default: nothing beyond its name).
+    fn fingerprint(&self, _f: &mut Fingerprint) {}
+
+    /// Writes the state that carries from one step to the next into a checkpoint (default:
+    /// none).
+    fn save_state(&self, _e: &mut Encoder) {}
+
+    /// Reads what [`StepStage::save_state`] wrote.
+    fn load_state(&mut self, _d: &mut Decoder) -> Result<(), GeometryError> {
+        Ok(())
     }
 
     /// The stage as `Any`, to reach its concrete type.

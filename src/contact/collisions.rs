@@ -128,16 +128,16 @@ pub struct Collisions {
     /// Contacts slide without friction while set (a garment being sewn slips into place).
     pub frictionless: bool,
     slots: Vec<Slot>,
-    last_impulse: Vec<f64>,
-    stuck: Vec<bool>,
+    pub(super) last_impulse: Vec<f64>,
+    pub(super) stuck: Vec<bool>,
     /// Per vertex: how deep inside a body it was at the last statistics pass (m, 0 outside).
-    depth: Vec<f64>,
-    self_collision: Option<SelfCollision>,
+    pub(super) depth: Vec<f64>,
+    pub(super) self_collision: Option<SelfCollision>,
     inv_mass: Vec<f64>,
     /// Per particle, the direction it slides along a body (zero if not sliding).
-    slip: Vec<Vec3>,
+    pub(super) slip: Vec<Vec3>,
     /// Per particle, the unit direction of the kinetic friction put into this step's solve.
-    applied: Vec<Vec3>,
+    pub(super) applied: Vec<Vec3>,
     ms: f64,
 }
 

@@ -216,6 +216,29 @@ impl MeshBody {
         self.aabb = crate::geometry::mesh::bounds(&self.positions);
     }
 
+    /// Current surface velocities (of the last move).
+    pub fn velocities(&self) -> &[Vec3] {
+        &self.velocities
+    }
+
+    /// Puts the mesh back where a checkpoint found it: `positions` with surface velocities
+    /// `velocities` (both one per vertex, else an error naming the body).
+    pub fn restore(&mut self, positions: &[Vec3], velocities: &[Vec3]) -> Result<(), ContactError> {
+        let n = self.positions.len();
+        if positions.len() != n || velocities.len() != n {
+            return Err(ContactError::Mesh {
+                body: self.name.clone(),
+                message: format!(
+                    "the checkpoint has {} vertices, the mesh {n}",
+                    positions.len()
+                ),
+            });
+        }
+        self.set_positions(positions, None);
+        self.velocities.copy_from_slice(velocities);
+        Ok(())
+    }
+
     /// Moves an animated mesh to its pose at time `t`, the last move lasting `dt`.
     pub fn advance_to(&mut self, t: f64, dt: f64) {
         if let Some(anim) = self.animation.clone() {

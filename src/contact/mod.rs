@@ -8,6 +8,7 @@ pub mod body;
 pub mod body_pin;
 pub mod ccd;
 pub mod character;
+pub mod checkpoint;
 pub mod collisions;
 pub mod error;
 pub mod floor;

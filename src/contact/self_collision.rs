@@ -78,7 +78,7 @@ pub struct SelfCollision {
     welds: Welds,
     /// Pass-through zones (0: none): a vertex never collides with a triangle or edge whose
     /// vertices all lie in its own zone (empty: no zones).
-    zone: Vec<u32>,
+    pub(super) zone: Vec<u32>,
 }
 
 /// Vertices sewn together: each vertex's weld class (`rep`, its representative; empty: none

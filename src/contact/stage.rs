@@ -9,7 +9,8 @@ use super::collisions::Collisions;
 use super::ContactError;
 use crate::cloth::stage::{Obstacles, StepEnd, StepStage};
 use crate::cloth::{ClothError, Filter, Sewing, Simulation, StepStats};
-use crate::geometry::Vec3;
+use crate::geometry::checkpoint::{Decoder, Encoder, Fingerprint};
+use crate::geometry::{GeometryError, Vec3};
 
 impl From<ContactError> for ClothError {
     fn from(e: ContactError) -> Self {
@@ -89,6 +90,18 @@ impl StepStage for Collisions {
 
     fn crossings(&mut self, x: &[Vec3]) -> Vec<([u32; 2], [u32; 3])> {
         self.self_intersections(x)
+    }
+
+    fn fingerprint(&self, f: &mut Fingerprint) {
+        self.fingerprint_into(f);
+    }
+
+    fn save_state(&self, e: &mut Encoder) {
+        self.save_into(e);
+    }
+
+    fn load_state(&mut self, d: &mut Decoder) -> Result<(), GeometryError> {
+        self.load_from(d)
     }
 
     fn as_any(&self) -> &dyn Any {

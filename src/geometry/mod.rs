@@ -5,6 +5,7 @@
 
 pub mod animation;
 pub mod camera;
+pub mod checkpoint;
 pub mod cone;
 pub mod error;
 pub mod export_frame;
@@ -17,6 +18,7 @@ pub mod mesh;
 pub mod obj;
 pub mod pc2;
 pub mod random;
+pub mod run_checkpoint;
 pub mod topology;
 pub mod usd;
 

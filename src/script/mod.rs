@@ -8,7 +8,9 @@
 //! - [`modules`]: the modules, the builder that collects them, the old names kept as aliases;
 //! - [`convert`]: error conversion, numbers and vectors, `…Parameters` ⇄ object maps;
 //! - [`fabric`]: the `Fabric` value type and the `Cloth` handle (`cloth::fabric()`, `cloth::grid`, …);
-//! - [`sim`]: the `Simulation` handle: constraints, stepping, runs with per-frame callbacks;
+//! - [`sim`]: the `Simulation` handle and its constraints; [`sim_run`]: stepping, runs with
+//!   per-frame callbacks; [`checkpoint`]: checkpoints and resumed runs, [`captured`]: the
+//!   variables their callbacks captured;
 //! - [`contact`]: collision bodies, the mannequin, friction, contact settings and read-outs;
 //! - [`output`]: positions, bounds, energies, OBJ/glTF/CSV/JSON/PNG output;
 //! - [`kes`]: the virtual Kawabata lab (fabric files, rigs, fitting, summaries);
@@ -21,6 +23,8 @@
 //!
 //! Big objects cross into Rhai as shared handles (`Shared<Locked<_>>`), never copied per call.
 
+pub mod captured;
+pub mod checkpoint;
 pub mod contact;
 pub mod convert;
 pub mod docs;
@@ -39,6 +43,7 @@ pub mod repl;
 pub mod run;
 pub mod sandbox;
 pub mod sim;
+pub mod sim_run;
 pub mod tracking;
 pub mod tracking_sequence;
 
@@ -167,6 +172,8 @@ pub fn build_engine_with(limits: EngineLimits) -> Engine {
     });
     fabric::register(&mut engine);
     sim::register(&mut engine);
+    sim_run::register(&mut engine);
+    checkpoint::register(&mut engine);
     contact::register(&mut engine);
     garment::register(&mut engine);
     output::register(&mut engine);

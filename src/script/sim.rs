@@ -2,12 +2,9 @@
 //! its constraints (pins, moving attachments, floor) and its runs, including runs that call a
 //! script closure once per step or per frame.
 
+use rhai::{Array, Dynamic, Locked, Map, Shared, INT};
 use std::cell::{Ref, RefMut};
 use std::fmt;
-use std::io::IsTerminal;
-
-use indicatif::ProgressBar;
-use rhai::{Array, Dynamic, FnPtr, Locked, Map, NativeCallContext, Shared, INT};
 
 use super::convert::{
     count, finite, get_field, indices, rt_err, to_map, update_field, update_from_map, vec3, RResult,
@@ -86,34 +83,6 @@ impl fmt::Display for SimHandle {
     }
 }
 
-/// A progress bar on a terminal, a hidden one otherwise.
-fn progress(len: u64) -> ProgressBar {
-    if std::io::stderr().is_terminal() && len >= 100 {
-        ProgressBar::new(len)
-    } else {
-        ProgressBar::hidden()
-    }
-}
-
-/// The map handed to run callbacks.
-fn frame_info(frame: u64, sim: &Simulation, h: &SimHandle) -> Map {
-    let mut m = Map::new();
-    m.insert("sim".into(), Dynamic::from(h.clone()));
-    m.insert("frame".into(), Dynamic::from_int(frame as INT));
-    m.insert("time".into(), Dynamic::from_float(sim.state.time));
-    m.insert("step".into(), Dynamic::from_int(sim.state.step as INT));
-    m
-}
-
-/// Calls `f(info)` with `this` bound to the simulation; a `false` result stops the run.
-/// (Rhai refuses a callback that captures the variable whose method is running, so the
-/// callback reaches the simulation through `this` or `info.sim`.)
-fn callback(ctx: &NativeCallContext, h: &SimHandle, f: &FnPtr, info: Map) -> RResult<bool> {
-    let mut this = Dynamic::from(h.clone());
-    let r: Dynamic = f.call_as_method_within_context(ctx, &mut this, (Dynamic::from_map(info),))?;
-    Ok(!matches!(r.as_bool(), Ok(false)))
-}
-
 /// Grid particle indices of a named edge or corner set of a grid cloth.
 fn grid_set(sim: &Simulation, which: &str, corners: bool) -> RResult<Vec<usize>> {
     let (nx, ny) = sim
@@ -189,18 +158,6 @@ fn trajectory(m: &Map) -> RResult<Trajectory> {
             "an oscillation needs both `amplitude` and `frequency`",
         )),
     }
-}
-
-/// Steps `n` times, with a progress bar on a terminal.
-fn run_n(h: &SimHandle, n: u64) -> RResult<()> {
-    let pb = progress(n);
-    let mut sim = h.get_mut()?;
-    sim.run_steps(n, |_, _| {
-        pb.inc(1);
-        Ok(())
-    })?;
-    pb.finish_and_clear();
-    Ok(())
 }
 
 /// Registers `cloth::simulation` and the `Simulation` methods for constraints and stepping.
@@ -331,79 +288,6 @@ up/down choice on a flat cloth (one side of the cloth per step for all its ties)
             Ok(())
         }
     );
-
-    register!(
-        engine,
-        "step",
-        ["sim: Simulation", "Map"],
-        "Advances one step; returns its statistics (see `stats`). A diverging step is an error.",
-        |h: &mut SimHandle| -> RResult<Dynamic> { Ok(to_map(&h.get_mut()?.step()?)) }
-    );
-    register!(
-        engine,
-        "run_steps",
-        ["sim: Simulation", "steps: int"],
-        "Advances `steps` steps (at most the limit `max_steps`, see docs/limits.md).",
-        |h: &mut SimHandle, n: INT| -> RResult<()> {
-            run_n(h, count(&Dynamic::from_int(n), "steps")? as u64)
-        }
-    );
-    register!(
-        engine,
-        "run",
-        ["sim: Simulation", "seconds: float"],
-        "Advances `seconds` of simulated time (rounded up to whole steps, at most the limit\n`max_steps`, see docs/limits.md).",
-        |h: &mut SimHandle, secs: Dynamic| -> RResult<()> {
-            let n = h.get()?.checked_steps_for(finite(&secs, "seconds")?)?;
-            run_n(h, n)
-        }
-    );
-    register!(engine, "run", ["sim: Simulation", "seconds: float", "callback: FnPtr"],
-        "Advances `seconds`, calling `callback(#{frame, time, step, sim})` after every step\n(`frame` counts the steps of this run from 1). A callback returning `false` stops the run.\nInside the callback the simulation is `this` (or `t.sim`); Rhai forbids capturing `sim` itself.",
-        |ctx: NativeCallContext, h: &mut SimHandle, secs: Dynamic, f: FnPtr| -> RResult<()> {
-            let n = h.get()?.checked_steps_for(finite(&secs, "seconds")?)?;
-            for k in 1..=n {
-                crate::limits::check_cancelled().map_err(rt_err)?;
-                let info = {
-                    let mut s = h.get_mut()?;
-                    s.step()?;
-                    frame_info(k, &s, h)
-                };
-                if !callback(&ctx, h, &f, info)? {
-                    break;
-                }
-            }
-            Ok(())
-        });
-    register!(engine, "run_frames", ["sim: Simulation", "frames: int", "fps: float", "callback: FnPtr"],
-        "Runs `frames` frames at `fps`, stepping to each frame time and then calling\n`callback(#{frame, time, step, sim})` (`frame` from 1). A callback returning `false` stops the run.\nWith a recording started (`record`), each frame is added to it and the cache is written at the end.\nInside the callback the simulation is `this` (or `t.sim`); Rhai forbids capturing `sim` itself.",
-        |ctx: NativeCallContext, h: &mut SimHandle, frames: INT, fps: Dynamic, f: FnPtr| -> RResult<()> {
-            let frames = count(&Dynamic::from_int(frames), "frames")? as u64;
-            let max = crate::limits::get().max_frames;
-            crate::limits::check_count("run_frames `frames`", frames, "max_frames", max).map_err(rt_err)?;
-            let fps = finite(&fps, "fps")?;
-            if fps <= 0.0 {
-                return Err(rt_err(format!("`fps` must be > 0, got {fps}")));
-            }
-            // the whole run's steps, refused before the first one
-            h.get()?.checked_steps_for(frames as f64 / fps)?;
-            let t0 = h.get()?.state.time;
-            for k in 1..=frames {
-                crate::limits::check_cancelled().map_err(rt_err)?;
-                let info = {
-                    let mut s = h.get_mut()?;
-                    let n = s.steps_for(t0 + k as f64 / fps - s.state.time);
-                    s.run_steps(n, |_, _| Ok(()))?;
-                    frame_info(k, &s, h)
-                };
-                h.capture_frame()?;
-                if !callback(&ctx, h, &f, info)? {
-                    break;
-                }
-            }
-            h.write_recording()?;
-            Ok(())
-        });
 
     getter!(
         engine,

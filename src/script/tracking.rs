@@ -5,14 +5,18 @@ use std::io::IsTerminal;
 use indicatif::ProgressBar;
 use rhai::{Dynamic, Map, INT};
 
+use super::checkpoint::{begin, resumed_file, Plan};
 use super::convert::{count, finite, rt_err, RResult};
 use super::paths::{read_folder, read_folder_opt, write_folder};
 use super::{function, modules::ApiBuilder};
 use crate::body::Mannequin;
+use crate::geometry::checkpoint::Fingerprint;
 use crate::geometry::files::data_path;
+use crate::tracking::checkpoint::TrackCheckpoint;
 use crate::tracking::sequence_files::Sequence;
+use crate::tracking::sequence_run::track_sequence_from;
 use crate::tracking::track_outputs::{arm_joints, write_track_outputs, TrackOutputOptions};
-use crate::tracking::tracker::{track_sequence, TrackerOptions};
+use crate::tracking::tracker::{TrackError, TrackerOptions};
 
 fn options(m: &Map) -> RResult<(TrackerOptions, TrackOutputOptions, Option<String>)> {
     let mut o = TrackerOptions::default();
@@ -81,12 +85,40 @@ fn track(seq_dir: &str, out: &str, m: &Map) -> RResult<Map> {
     let bar = std::io::stderr()
         .is_terminal()
         .then(|| ProgressBar::new(total as u64));
-    let result = track_sequence(&seq, &mannequin, &options, None, |done, _| {
+    // the call's setup: the sequence, the body model, the options and the frames tracked
+    let (call, plan) = begin("track_body", || {
+        let mut f = Fingerprint::default();
+        f.str(&seq.dir.display().to_string())
+            .str(&mh.display().to_string())
+            .str(&format!("{options:?}"))
+            .u64(total as u64);
+        f.value()
+    })?;
+    let resume = match plan {
+        Plan::Run => None,
+        Plan::Finished(rec) | Plan::Continue(rec) => Some(
+            TrackCheckpoint::decode(&rec.state, &resumed_file())
+                .map_err(|e| rt_err(e.to_string()))?,
+        ),
+    };
+    let mut last = None;
+    let result = track_sequence_from(&seq, &mannequin, &options, None, resume, |done, _, ck| {
         if let Some(b) = &bar {
             b.set_position(done as u64);
         }
+        if call.due(done as u64) && done < total {
+            call.save(done as u64, 0.0, ck().encode())
+                .map_err(|e| TrackError::Invalid(e.to_string()))?;
+        }
+        if done == total && call.active() {
+            last = Some(ck().encode());
+        }
+        Ok(())
     })
     .map_err(rt_err)?;
+    if let Some(state) = last {
+        call.finish(total as u64, 0.0, || Ok(state))?;
+    }
     if let Some(b) = bar {
         b.finish_and_clear();
     }

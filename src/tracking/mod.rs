@@ -17,6 +17,7 @@
 pub mod annealing;
 pub mod bvh_export;
 pub mod calibration;
+pub mod checkpoint;
 pub mod clothing;
 pub mod correspondences;
 pub mod cost;
@@ -29,6 +30,7 @@ pub mod pyramid;
 pub mod restarts;
 pub mod sequence;
 pub mod sequence_files;
+pub mod sequence_run;
 pub mod swing_metrics;
 pub mod texture;
 pub mod track_outputs;

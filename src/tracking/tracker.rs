@@ -21,7 +21,7 @@ use image::RgbImage;
 
 use super::annealing::{anneal, AnnealScratch, AnnealSettings};
 use super::cost::{pose_cost, Appearance, CostWorkspace, FrameViews, Robust};
-use super::joints::{mpjpe, JOINT_COUNT};
+use super::joints::JOINT_COUNT;
 use super::puppet::{PartGroup, Puppet};
 use super::puppet_mesh::TrackingMesh;
 use super::pyramid::{median_background, Level};
@@ -151,12 +151,12 @@ impl TrackResult {
 }
 
 /// One stage of the hierarchical search: a name and the parameter groups it moves.
-struct Stage {
-    name: &'static str,
+pub(super) struct Stage {
+    pub(super) name: &'static str,
     groups: &'static [PartGroup],
 }
 
-const STAGES: &[Stage] = &[
+pub(super) const STAGES: &[Stage] = &[
     Stage {
         name: "torso",
         groups: &[PartGroup::Root, PartGroup::Torso],
@@ -199,15 +199,15 @@ fn move_sigma(k: usize, group: PartGroup) -> f64 {
 pub struct Tracker {
     puppet: Puppet,
     mesh: TrackingMesh,
-    colours: Option<Vec<[f32; 3]>>,
-    views: FrameViews,
+    pub(super) colours: Option<Vec<[f32; 3]>>,
+    pub(super) views: FrameViews,
     workspaces: Vec<Mutex<CostWorkspace>>,
     options: TrackerOptions,
-    rng: SplitMix64,
-    history: Vec<Vec<f64>>,
+    pub(super) rng: SplitMix64,
+    pub(super) history: Vec<Vec<f64>>,
     scratch: AnnealScratch,
-    stage_seconds: Vec<f64>,
-    evaluations: usize,
+    pub(super) stage_seconds: Vec<f64>,
+    pub(super) evaluations: usize,
 }
 
 impl Tracker {
@@ -573,81 +573,4 @@ pub fn sequence_backgrounds(
         .iter()
         .map(|imgs| median_background(&imgs.iter().collect::<Vec<_>>()))
         .collect())
-}
-
-/// Tracks a whole sequence (or its first `options.frames` frames). `progress(done, total)`
-/// is called after each frame.
-pub fn track_sequence(
-    seq: &Sequence,
-    mannequin: &Mannequin,
-    options: &TrackerOptions,
-    approx: Option<&[Vec3; JOINT_COUNT]>,
-    mut progress: impl FnMut(usize, usize),
-) -> Result<TrackResult, TrackError> {
-    let t_start = Instant::now();
-    let frames = options.frames.map_or(seq.frames, |f| f.min(seq.frames));
-    if frames == 0 {
-        return Err(TrackError::Invalid(format!(
-            "{}: no frames to track",
-            seq.dir.display()
-        )));
-    }
-    let approx = approx.or(seq.init_joints.as_ref()).ok_or_else(|| {
-        TrackError::Invalid(format!(
-            "{}: no init_joints.csv, and no approximate first pose given",
-            seq.dir.display()
-        ))
-    })?;
-    let backgrounds = match seq.background_plates()? {
-        Some(plates) => plates.iter().map(Level::from_image).collect(),
-        None => sequence_backgrounds(seq, seq.frames, options.background_frames)?,
-    };
-    let mut tracker = Tracker::new(mannequin, &seq.cameras, &backgrounds, options.clone())?;
-    let robust = Robust {
-        sigma: options.robust_sigma,
-    };
-    let masks = changing_pixels(seq, &backgrounds, options.background_frames, robust, 0.2)?;
-    tracker.views.set_active(&masks);
-    let mut result = TrackResult::default();
-    let t_io = Instant::now();
-    let images = seq.frame_images(0)?;
-    result.io_seconds += t_io.elapsed().as_secs_f64();
-    let first = tracker.start(&images, approx)?;
-    tracker.stage_seconds.iter_mut().for_each(|s| *s = 0.0);
-    tracker.evaluations = 0;
-    result.start_seconds = t_start.elapsed().as_secs_f64();
-    result.joints.push(tracker.joints(&first));
-    result.params.push(first);
-    result.costs.push(0.0);
-    progress(1, frames);
-    for k in 1..frames {
-        let t0 = Instant::now();
-        let images = seq.frame_images(k)?;
-        result.io_seconds += t0.elapsed().as_secs_f64();
-        let (params, cost) = tracker.track(&images)?;
-        result.joints.push(tracker.joints(&params));
-        result.params.push(params);
-        result.costs.push(cost);
-        result.frame_seconds.push(t0.elapsed().as_secs_f64());
-        progress(k + 1, frames);
-    }
-    result.stage_seconds = STAGES
-        .iter()
-        .zip(&tracker.stage_seconds)
-        .map(|(s, &t)| (s.name.to_string(), t))
-        .collect();
-    result.evaluations = tracker.evaluations;
-    if let Some(gt) = &seq.ground_truth {
-        let mut per_frame = Vec::new();
-        let mut per_joint = Vec::new();
-        for (k, j) in result.joints.iter().enumerate() {
-            if let Some(t) = gt.get(k) {
-                per_frame.push(1000.0 * mpjpe(j, t));
-                per_joint.push(std::array::from_fn(|i| 1000.0 * (j[i] - t[i]).norm()));
-            }
-        }
-        result.errors_mm = Some(per_frame);
-        result.joint_errors_mm = Some(per_joint);
-    }
-    Ok(result)
 }

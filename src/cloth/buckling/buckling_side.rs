@@ -68,6 +68,16 @@ impl BucklingSides {
         }
     }
 
+    /// The random generator's state (for a checkpoint).
+    pub fn rng_state(&self) -> u64 {
+        self.rng.state()
+    }
+
+    /// Continues the random draws from a saved [`BucklingSides::rng_state`].
+    pub fn set_rng_state(&mut self, state: u64) {
+        self.rng = SplitMix64::new(state);
+    }
+
     /// Starts the arc of every compressed connection whose middle lies on its chord, moving
     /// the middle particles (except those `held`) along the cloth's normal: to the side where
     /// `clear` holds if only one does, else to the side of the cloth drawn at random for this

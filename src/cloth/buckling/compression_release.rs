@@ -527,6 +527,61 @@ impl StepStage for CompressionRelease {
         self.order = order;
     }
 
+    fn fingerprint(&self, f: &mut crate::geometry::checkpoint::Fingerprint) {
+        f.str(&format!("{:?}", self.options))
+            .u64(self.nx as u64)
+            .u64(self.ny as u64)
+            .u64(self.springs.len() as u64);
+    }
+
+    fn save_state(&self, e: &mut crate::geometry::checkpoint::Encoder) {
+        e.usize(self.held.len());
+        for (p, dest, left) in &self.held {
+            e.usize(*p);
+            e.vec3(dest);
+            e.u32(*left);
+        }
+        e.usize(self.blocked.len());
+        self.blocked.iter().for_each(|&b| e.u32(b));
+        e.u64(self.rng.state());
+        e.u8(match self.tie_side {
+            None => 0,
+            Some(false) => 1,
+            Some(true) => 2,
+        });
+        e.u64(self.releases);
+    }
+
+    fn load_state(
+        &mut self,
+        d: &mut crate::geometry::checkpoint::Decoder,
+    ) -> Result<(), crate::geometry::GeometryError> {
+        let n = self.pattern.len();
+        let held = d.len(36, "held particles")?;
+        self.held = (0..held)
+            .map(|_| Ok((d.usize("held particle")?, d.vec3("hold")?, d.u32("hold")?)))
+            .collect::<Result<_, crate::geometry::GeometryError>>()?;
+        if self.held.iter().any(|h| h.0 >= n) {
+            return Err(d.error("a held particle the cloth does not have"));
+        }
+        let blocked = d.len(4, "blocked particles")?;
+        if blocked != self.blocked.len() {
+            return Err(d.error("blocked particles of another cloth"));
+        }
+        self.blocked = (0..blocked)
+            .map(|_| d.u32("blocked"))
+            .collect::<Result<_, _>>()?;
+        self.rng = crate::geometry::SplitMix64::new(d.u64("random state")?);
+        self.tie_side = match d.u8("tie side")? {
+            0 => None,
+            1 => Some(false),
+            2 => Some(true),
+            b => return Err(d.error(format!("tie side {b}"))),
+        };
+        self.releases = d.u64("releases")?;
+        Ok(())
+    }
+
     fn as_any(&self) -> &dyn std::any::Any {
         self
     }

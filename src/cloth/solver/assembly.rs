@@ -74,15 +74,15 @@ pub struct Assembly {
     energy_partials: Vec<f64>,
     /// Friction states (committed coordinate, friction force) per element, allocated on the
     /// first assembly with a law that has internal friction; NaN coordinate = not yet seen.
-    fric_spring: Vec<[f64; 2]>,
-    fric_quad: Vec<[f64; 2]>,
-    fric_bend: Vec<[Vec3; 2]>,
-    fric_hinge: Vec<[f64; 2]>,
+    pub(in crate::cloth) fric_spring: Vec<[f64; 2]>,
+    pub(in crate::cloth) fric_quad: Vec<[f64; 2]>,
+    pub(in crate::cloth) fric_bend: Vec<[Vec3; 2]>,
+    pub(in crate::cloth) fric_hinge: Vec<[f64; 2]>,
     /// Trial friction states of the last evaluation (committed by [`Assembly::commit_friction`]).
-    trial_spring: Vec<[f64; 2]>,
-    trial_quad: Vec<[f64; 2]>,
-    trial_bend: Vec<[Vec3; 2]>,
-    trial_hinge: Vec<[f64; 2]>,
+    pub(in crate::cloth) trial_spring: Vec<[f64; 2]>,
+    pub(in crate::cloth) trial_quad: Vec<[f64; 2]>,
+    pub(in crate::cloth) trial_bend: Vec<[Vec3; 2]>,
+    pub(in crate::cloth) trial_hinge: Vec<[f64; 2]>,
     /// Commit the friction states after every assembly (true for time stepping, where every
     /// assembly happens at an accepted state); quasi-static solvers set it false and commit
     /// once an increment has converged.

@@ -246,6 +246,24 @@ impl Multigrid {
         self.levels.len()
     }
 
+    /// Writes what carries from one step to the next: the coarse levels' friction states.
+    pub fn save_state(&self, e: &mut crate::geometry::checkpoint::Encoder) {
+        for asm in self.levels.iter().filter_map(|l| l.asm.as_ref()) {
+            asm.save_friction(e);
+        }
+    }
+
+    /// Reads what [`Multigrid::save_state`] wrote.
+    pub fn load_state(
+        &mut self,
+        d: &mut crate::geometry::checkpoint::Decoder,
+    ) -> Result<(), crate::geometry::GeometryError> {
+        for asm in self.levels.iter_mut().filter_map(|l| l.asm.as_mut()) {
+            asm.load_friction(d)?;
+        }
+        Ok(())
+    }
+
     /// Rebuilds every level's operator for the current step: coarse states sampled from the
     /// fine one, coarse matrices assembled, fixed particles mapped, lines factorised. The
     /// filter's fixed particles are fixed on every level; its velocity-constrained directions
