@@ -187,7 +187,7 @@ pub fn check_geometry(points: &[[f64; 2]], source: &str) -> Result<(), FaceError
         return Err(err(format!("landmark {i} is not finite")));
     }
     let iod = inter_ocular_distance(points);
-    if !(iod >= MIN_IOD_PX) {
+    if iod.is_nan() || iod < MIN_IOD_PX {
         return Err(err(format!(
             "degenerate landmarks: the outer eye corners (points {IBUG_RIGHT_EYE_OUTER} and {IBUG_LEFT_EYE_OUTER}) are {iod:.3} px apart, less than {MIN_IOD_PX} px"
         )));
@@ -209,7 +209,7 @@ pub fn check_geometry(points: &[[f64; 2]], source: &str) -> Result<(), FaceError
     let minor = (half - (0.25 * (sxx - syy).powi(2) + sxy * sxy).sqrt())
         .max(0.0)
         .sqrt();
-    if !(minor >= MIN_SPREAD_IOD * iod) {
+    if minor.is_nan() || minor < MIN_SPREAD_IOD * iod {
         return Err(err(format!(
             "degenerate landmarks: the points lie on a line (spread {minor:.3} px across it, less than {MIN_SPREAD_IOD} × the inter-ocular distance {iod:.1} px)"
         )));

@@ -2,7 +2,7 @@
 # Runs the issue-48 cloth/garment/body cases with a release binary, as they were reported:
 # one thread, a 4 GB address-space limit, 20 s. Usage (from the repository root):
 #   tests/hostile_cloth/run_cases.sh [BINARY] [WORK_DIR]
-# Prints, per case: exit status, seconds, peak RSS (MB) and the last line of output.
+# Prints, per case: exit status, seconds, peak RSS (MB) and the first line of output (the error).
 # The generated inputs (10,000 nested <g>, a BVH whose Frame Time is 1e9) go to WORK_DIR.
 set -u
 bin=${1:-target/release/emilion}
@@ -30,7 +30,7 @@ run() { # name script [--set k=v ...]
   local t1=$(date +%s.%N)
   local rss=$(tail -1 "$work/$name.rss" 2>/dev/null)
   printf '%-24s rc=%-3s %6.1fs %6s MB  %s\n' "$name" "$rc" "$(echo "$t1 - $t0" | bc)" \
-    "$(( ${rss:-0} / 1024 ))" "$(grep -v '^\s*$' "$log" | grep -v '^ *|\|^ *\^' | tail -1 | cut -c1-170)"
+    "$(( ${rss:-0} / 1024 ))" "$(grep -v '^\s*$' "$log" | head -1 | cut -c1-170)"
 }
 for c in sim_run_1e9 sim_run_1e300 run_steps_int_max dt_tiny dt_huge run_callback_1e9 \
          explicit_substeps_1e9 run_frames_fps_tiny release_out_of_range cloth_grid_1e6 \
