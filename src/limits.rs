@@ -129,6 +129,17 @@ impl fmt::Display for LimitError {
 
 impl std::error::Error for LimitError {}
 
+/// A number as text for messages: as written when ordinary, in exponent form (`1e300`) when
+/// huge or tiny, so an error never prints three hundred digits.
+pub fn short(v: f64) -> String {
+    let a = v.abs();
+    if v.is_finite() && a != 0.0 && !(1e-4..1e9).contains(&a) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
 /// Checks a count or size `value` (a float from a script or file: NaN, infinite and negative
 /// values are refused too) against `max`, named `limit`; returns it as an integer.
 pub fn check(what: &str, value: f64, limit: &'static str, max: u64) -> Result<u64, LimitError> {
@@ -137,7 +148,7 @@ pub fn check(what: &str, value: f64, limit: &'static str, max: u64) -> Result<u6
     } else {
         Err(LimitError {
             what: what.to_string(),
-            value: format!("{value}"),
+            value: short(value),
             limit,
             max,
         })
@@ -269,6 +280,9 @@ mod tests {
         }
         assert!(check_alloc("stats", u64::MAX, 8).is_err());
         assert!(check_alloc("stats", 100, 8).is_ok());
+        assert_eq!(short(1e300), "1e300");
+        assert_eq!(short(0.25), "0.25");
+        assert_eq!(short(4000000.0), "4000000");
     }
 
     #[test]

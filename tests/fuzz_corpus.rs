@@ -1,8 +1,8 @@
 //! The fuzz corpus, replayed: every input under `tests/fuzz/<reader>/` (the seeds) and
 //! `tests/fuzz/<reader>/crashes/` (what the harness found, since fixed) goes through its reader
-//! (`examples/fuzz/targets.rs`) without a panic and within a time bound. The inputs under
-//! `tests/fuzz/<reader>/known/` are crashes whose fixes are being made elsewhere: they are
-//! replayed only with `--ignored`. See docs/fuzzing.md.
+//! (`examples/fuzz/targets.rs`) without a panic and within a time bound. An input whose fix is
+//! still to come goes under `tests/fuzz/<reader>/known/`, replayed only with `--ignored` (none
+//! today). See docs/fuzzing.md.
 
 #[allow(dead_code)] // the harness's mutation settings are not used here
 #[path = "../examples/fuzz/targets.rs"]
@@ -106,7 +106,7 @@ fn seeds_are_read_as_their_readers_expect() {
 }
 
 #[test]
-#[ignore = "known crashes whose fixes are being merged: run with --ignored"]
+#[ignore = "known crashes whose fixes are still to come: run with --ignored"]
 fn known_crashes_read_without_a_panic() {
     replay("known");
 }

@@ -43,7 +43,11 @@ pub fn rectangle_mesh(width: f64, height: f64, edge_length: f64) -> Result<TriMe
     };
     let pattern = Pattern {
         name: "rectangle".into(),
-        source: format!("rectangle {width} m × {height} m"),
+        source: format!(
+            "rectangle {} m × {} m",
+            crate::limits::short(width),
+            crate::limits::short(height)
+        ),
         pieces: vec![piece],
         seams: Vec::new(),
     };
