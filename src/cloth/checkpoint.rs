@@ -37,6 +37,7 @@ fn save_stats(e: &mut Encoder, s: &StepStats) {
     e.f64(s.min_distance);
     e.usize(s.penetrating);
     e.usize(s.intersections);
+    e.u32(s.retries);
 }
 
 fn load_stats(d: &mut Decoder) -> Result<StepStats, GeometryError> {
@@ -60,6 +61,7 @@ fn load_stats(d: &mut Decoder) -> Result<StepStats, GeometryError> {
         min_distance: d.f64(w)?,
         penetrating: d.usize(w)?,
         intersections: d.usize(w)?,
+        retries: d.u32(w)?,
     })
 }
 
@@ -114,7 +116,7 @@ impl Assembly {
 }
 
 /// Bytes of one encoded [`StepStats`].
-const STATS_BYTES: usize = 8 * 6 + 4 + 8 + 1 + 8 * 4 + 8 * 2 + 8 + 8 * 2;
+const STATS_BYTES: usize = 8 * 6 + 4 + 8 + 1 + 8 * 4 + 8 * 2 + 8 + 8 * 2 + 4;
 
 impl Simulation {
     /// The fingerprint of the simulation's setup: particle count, mesh (triangles, rest and
@@ -172,6 +174,23 @@ impl Simulation {
         e.u64(self.unconverged_steps);
         e.f64(self.gravity_share);
         e.vec3s(&self.dv);
+        // the step guard: what the next step's checks compare with
+        e.u64(self.retried_steps);
+        e.bool(self.sewing_settled);
+        e.bool(self.stages_constrain);
+        e.bool(self.guard.record.is_some());
+        if let Some(r) = &self.guard.record {
+            e.u64(r.step);
+            for v in [r.span.0, r.span.1, r.total, r.work, r.scale] {
+                e.f64(v);
+            }
+            for v in r.gravity.iter() {
+                e.f64(*v);
+            }
+        }
+        for v in [&self.x_save, &self.v_save, &self.x_prev, &self.v_prev] {
+            e.vec3s(v);
+        }
         // element parameters a sewing schedule changes
         let m = &self.model;
         e.f64s(&m.springs.iter().map(|s| s.rest).collect::<Vec<_>>());
@@ -257,6 +276,30 @@ impl Simulation {
         self.unconverged_steps = d.u64("unconverged steps")?;
         self.gravity_share = d.f64("gravity share")?;
         d.vec3s_into(&mut self.dv, "warm start")?;
+        self.retried_steps = d.u64("retried steps")?;
+        self.sewing_settled = d.bool("step guard")?;
+        self.stages_constrain = d.bool("step guard")?;
+        self.guard.record = if d.bool("step guard")? {
+            let w = "step guard";
+            let step = d.u64(w)?;
+            let span = (d.f64(w)?, d.f64(w)?);
+            let (total, work, scale) = (d.f64(w)?, d.f64(w)?, d.f64(w)?);
+            let gravity = crate::geometry::Vec3::new(d.f64(w)?, d.f64(w)?, d.f64(w)?);
+            Some(super::step_guard::EnergyRecord {
+                step,
+                span,
+                total,
+                work,
+                scale,
+                gravity,
+            })
+        } else {
+            None
+        };
+        d.vec3s_into(&mut self.x_save, "step start")?;
+        d.vec3s_into(&mut self.v_save, "step start")?;
+        d.vec3s_into(&mut self.x_prev, "step before")?;
+        d.vec3s_into(&mut self.v_prev, "step before")?;
         let rests = d.f64s("spring rest lengths")?;
         let seams = d.f64s("seam threads")?;
         let weights = d.f64s("hinge weights")?;

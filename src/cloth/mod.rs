@@ -17,6 +17,7 @@ pub mod solver;
 pub mod stage;
 pub mod state;
 pub mod stats;
+pub mod step_guard;
 
 pub use constraints::{Attachment, Filter, Trajectory};
 pub use elements::material::{Direction, FabricParameters, Friction, LinearMaterial, MaterialLaw};

@@ -1,6 +1,9 @@
 //! `Simulation`: a cloth model, its state, constraints and step stages, stepped by the
-//! implicit (Baraff–Witkin) or the explicit (symplectic Euler) integrator. Every step checks
-//! for divergence and leaves the state untouched when it fails.
+//! implicit (Baraff–Witkin, [`implicit`]) or the explicit (symplectic Euler) integrator. Every
+//! step checks for divergence and leaves the state untouched when it fails; an implicit step
+//! is guarded further ([`super::step_guard`]) and retried smaller when it fails.
+
+mod implicit;
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -14,10 +17,11 @@ use super::sewing::Sewing;
 use super::solver::amg::AggregationMultigrid;
 use super::solver::assembly::{Assembly, AssemblyInputs};
 use super::solver::multigrid::Multigrid;
-use super::solver::pcg::{PcgResult, PcgWorkspace, Preconditioner};
-use super::stage::{Obstacles, StepEnd, StepStage};
+use super::solver::pcg::PcgWorkspace;
+use super::stage::{Obstacles, StepStage};
 use super::state::ClothState;
 use super::stats::StepStats;
+use super::step_guard::StepGuard;
 use super::ClothError;
 use crate::geometry::Vec3;
 
@@ -70,6 +74,8 @@ pub struct Simulation {
     pub sewing: Option<Sewing>,
     /// Steps whose CG solve did not reach the tolerance.
     pub unconverged_steps: u64,
+    /// Implicit steps that failed whole and were retried split into substeps.
+    pub retried_steps: u64,
     /// Share of `params.gravity` acting (a garment's sewing turns it down while it sews).
     pub(super) gravity_share: f64,
     /// Stages of every step beside the cloth's forces (contact), in the order added.
@@ -77,8 +83,19 @@ pub struct Simulation {
     filter: Filter,
     z: Vec<Vec3>,
     pub(super) dv: Vec<Vec3>,
-    x_save: Vec<Vec3>,
-    v_save: Vec<Vec3>,
+    /// The state at the start of the step (after it: the state it left, to see whether
+    /// anything moved the cloth between steps).
+    pub(super) x_save: Vec<Vec3>,
+    pub(super) v_save: Vec<Vec3>,
+    /// The state at the start of the step before (to rewind a step found to gain energy).
+    pub(super) x_prev: Vec<Vec3>,
+    pub(super) v_prev: Vec<Vec3>,
+    /// The checks of a step and the last step's energy.
+    pub(super) guard: StepGuard,
+    /// Whether the sewing (if any) had stopped changing the model at the last step.
+    pub(super) sewing_settled: bool,
+    /// Whether a stage constrained particles in the last step's filter (contact, holds).
+    pub(super) stages_constrain: bool,
     impulse: Vec<Vec3>,
     x_step: Vec<Vec3>,
     pub(super) asm: Assembly,
@@ -110,11 +127,17 @@ impl Simulation {
             stats: Vec::new(),
             sewing: None,
             unconverged_steps: 0,
+            retried_steps: 0,
+            guard: StepGuard::new(&model),
+            sewing_settled: true,
+            stages_constrain: false,
             filter: Filter::new(n),
             z: vec![Vec3::zeros(); n],
             dv: vec![Vec3::zeros(); n],
             x_save: vec![Vec3::zeros(); n],
             v_save: vec![Vec3::zeros(); n],
+            x_prev: vec![Vec3::zeros(); n],
+            v_prev: vec![Vec3::zeros(); n],
             asm,
             pcg: PcgWorkspace::new(n),
             mg,
@@ -127,6 +150,7 @@ impl Simulation {
     /// from the old one (the geometric multigrid's coarse cloths).
     pub fn set_material(&mut self, law: Arc<dyn MaterialLaw>) -> Result<(), ClothError> {
         self.model.set_law(law);
+        self.guard = StepGuard::new(&self.model);
         let (mg, amg) = preconditioners(&self.model, &self.params, &mut self.asm)?;
         self.mg = mg;
         self.amg = amg;
@@ -301,6 +325,17 @@ impl Simulation {
                 self.filter.any = true;
             }
         }
+        let constrained = |f: &Filter| {
+            f.kind
+                .iter()
+                .filter(|k| **k != ParticleFilter::Free)
+                .count()
+        };
+        let attached = if self.stages.is_empty() {
+            0
+        } else {
+            constrained(&self.filter)
+        };
         // each stage sees the obstacles of the stages before it
         for k in 0..self.stages.len() {
             let (before, rest) = self.stages.split_at_mut(k);
@@ -313,6 +348,7 @@ impl Simulation {
                 Obstacles::of(before),
             );
         }
+        self.stages_constrain = !self.stages.is_empty() && constrained(&self.filter) != attached;
     }
 
     /// Advances one step of `params.dt`.
@@ -324,12 +360,15 @@ impl Simulation {
     fn step_inner(&mut self) -> Result<StepStats, ClothError> {
         self.params.validate()?;
         let t_start = Instant::now();
+        // the model is the last step's unless a sewing still changes it
+        let same_model = self.sewing_settled;
         if let Some(sew) = &mut self.sewing {
             self.gravity_share = sew.update(&mut self.model, self.state.time, &self.state.x);
             for stage in &mut self.stages {
                 stage.follow_sewing(sew, self.state.time);
             }
         }
+        self.sewing_settled = self.sewing_quiet();
         if let Some(sides) = &mut self.sides {
             let attachments = &self.attachments;
             let obstacles = Obstacles::of(&self.stages);
@@ -339,22 +378,31 @@ impl Simulation {
                 |p| obstacles.is_clear(p),
             );
         }
-        self.x_save.copy_from_slice(&self.state.x);
-        self.v_save.copy_from_slice(&self.state.v);
-        let mut st = match self.params.integrator {
-            Integrator::Implicit => self.step_implicit(),
-            Integrator::Explicit => self.step_explicit(),
-        };
-        if let Err(cause) = self.check_state() {
-            let err = ClothError::Diverged {
-                step: self.state.step,
-                time: self.state.time,
-                cause,
-            };
-            self.state.x.copy_from_slice(&self.x_save);
-            self.state.v.copy_from_slice(&self.v_save);
-            return Err(err);
+        // `x_save` holds the state the last step left: the energy check holds while nothing
+        // moved the cloth since
+        if !(same_model && self.state.x == self.x_save && self.state.v == self.v_save) {
+            self.x_save.copy_from_slice(&self.state.x);
+            self.v_save.copy_from_slice(&self.state.v);
+            self.guard.forget();
         }
+        let mut st = match self.params.integrator {
+            Integrator::Implicit => self.advance_implicit()?,
+            Integrator::Explicit => {
+                self.guard.forget();
+                let st = self.step_explicit();
+                if let Err(cause) = self.check_state() {
+                    let err = ClothError::Diverged {
+                        step: self.state.step,
+                        time: self.state.time,
+                        cause,
+                    };
+                    self.state.x.copy_from_slice(&self.x_save);
+                    self.state.v.copy_from_slice(&self.v_save);
+                    return Err(err);
+                }
+                st
+            }
+        };
         if let Some(sew) = &self.sewing {
             sew.slow_down(self.state.time, &mut self.state.v);
             if let Some(sep) = sew.separation.as_ref() {
@@ -374,10 +422,26 @@ impl Simulation {
         if !st.converged {
             self.unconverged_steps += 1;
         }
+        if st.retries > 0 {
+            self.retried_steps += 1;
+        }
         self.state.step += 1;
         self.state.time += self.params.dt;
         self.stats.push(st);
+        // keep this step's start (to rewind it) and the state it left
+        std::mem::swap(&mut self.x_prev, &mut self.x_save);
+        std::mem::swap(&mut self.v_prev, &mut self.v_save);
+        self.x_save.copy_from_slice(&self.state.x);
+        self.v_save.copy_from_slice(&self.state.v);
         Ok(st)
+    }
+
+    /// Whether a garment's sewing has stopped changing the model (its threads' rest lengths
+    /// at zero, the seams stitched); true without sewing.
+    fn sewing_quiet(&self) -> bool {
+        self.sewing
+            .as_ref()
+            .is_none_or(|s| !s.sewing_at(self.state.time) && self.state.time >= s.closing_time())
     }
 
     fn check_state(&self) -> Result<(), String> {
@@ -398,143 +462,6 @@ impl Simulation {
             }
         }
         Ok(())
-    }
-
-    fn step_implicit(&mut self) -> StepStats {
-        let h = self.params.dt;
-        let t_end = self.state.time + h;
-        self.build_filter(t_end, h);
-        let (kinetic, gravity) = self.kinetic_gravity();
-        let t0 = Instant::now();
-        let inp = AssemblyInputs {
-            dt: h,
-            gravity: self.gravity(),
-            matrix: true,
-        };
-        let elastic = self
-            .asm
-            .assemble(&self.model, &self.state.x, &self.state.v, inp);
-        for stage in &mut self.stages {
-            stage.add_forces(&mut self.asm.b);
-        }
-        let t1 = Instant::now();
-        for i in 0..self.particle_count() {
-            self.z[i] = self.filter.z(i, &self.state.x[i], &self.state.v[i], h);
-        }
-        if !self.params.warm_start {
-            self.dv.fill(Vec3::zeros());
-        }
-        let mut precond = match (self.mg.as_mut(), self.amg.as_mut()) {
-            (Some(mg), _) => {
-                mg.setup(&self.asm.a, &self.state.x, &self.state.v, &self.filter, inp);
-                Preconditioner::Multigrid(mg)
-            }
-            (None, Some(amg)) => {
-                amg.setup(&self.asm.a, &self.filter);
-                Preconditioner::Aggregation(amg)
-            }
-            (None, None) => Preconditioner::BlockJacobi(&self.asm.pinv),
-        };
-        let mut res = self.pcg.solve(
-            &self.asm.a,
-            &self.asm.b,
-            &mut precond,
-            &self.filter,
-            &self.z,
-            &mut self.dv,
-            self.params.cg_tolerance,
-            self.params.cg_max_iterations,
-        );
-        let multigrid = self.mg.is_some() || self.amg.is_some();
-        if !res.converged && res.iterations < self.params.cg_max_iterations && multigrid {
-            // the multigrid preconditioner broke down (lost definiteness on an extreme
-            // configuration): finish the solve with block-Jacobi from where it stopped
-            self.asm.form_block_jacobi();
-            let again = self.pcg.solve(
-                &self.asm.a,
-                &self.asm.b,
-                &mut Preconditioner::BlockJacobi(&self.asm.pinv),
-                &self.filter,
-                &self.z,
-                &mut self.dv,
-                self.params.cg_tolerance,
-                self.params.cg_max_iterations - res.iterations,
-            );
-            res = PcgResult {
-                iterations: res.iterations + again.iterations,
-                ..again
-            };
-        }
-        let t2 = Instant::now();
-        if self.stages_use_impulses() {
-            self.x_step.copy_from_slice(&self.state.x);
-            // constraint impulses: the residual A Δv − b lies in the constrained directions
-            for i in 0..self.particle_count() {
-                self.impulse[i] = match self.filter.kind[i] {
-                    ParticleFilter::Free => Vec3::zeros(),
-                    _ => self.asm.a.row_times(i, &self.dv) - self.asm.b[i],
-                };
-            }
-        }
-        // while sewing, no particle moves faster than the sewing allows, even on a step whose
-        // solve did not converge
-        let cap = self
-            .sewing
-            .as_ref()
-            .filter(|s| s.sewing_at(self.state.time))
-            .map_or(f64::INFINITY, |s| s.max_speed);
-        for i in 0..self.particle_count() {
-            self.state.v[i] += self.dv[i];
-            let speed = self.state.v[i].norm();
-            if speed > cap {
-                self.state.v[i] *= cap / speed;
-            }
-            self.state.x[i] += self.state.v[i] * h;
-        }
-        self.finish_constraints(h);
-        StepStats {
-            kinetic,
-            gravity,
-            elastic,
-            total: kinetic + gravity + elastic,
-            cg_iterations: res.iterations,
-            residual: res.residual,
-            converged: res.converged,
-            assemble_ms: (t1 - t0).as_secs_f64() * 1e3,
-            solve_ms: (t2 - t1).as_secs_f64() * 1e3,
-            ..Default::default()
-        }
-    }
-
-    /// Snaps fixed particles exactly onto their targets, then runs the stages' responses
-    /// (friction, push-out, self-collision), last added first, on the step of length `h` that
-    /// started at `x_step`.
-    fn finish_constraints(&mut self, h: f64) {
-        for i in 0..self.particle_count() {
-            if let ParticleFilter::Fixed { target } = self.filter.kind[i] {
-                self.state.x[i] = target;
-            }
-        }
-        for stage in self.stages.iter_mut().rev() {
-            stage.respond(StepEnd {
-                x_start: &self.x_step,
-                x: &mut self.state.x,
-                v: &mut self.state.v,
-                impulse: &self.impulse,
-                mass: &self.model.mass,
-                filter: &self.filter,
-                dt: h,
-            });
-        }
-    }
-
-    /// Copies the stages' statistics of the last step into `st` (no body near: an infinite
-    /// distance).
-    fn contact_stats(&self, st: &mut StepStats) {
-        st.min_distance = f64::INFINITY;
-        for stage in &self.stages {
-            stage.report(st);
-        }
     }
 
     fn step_explicit(&mut self) -> StepStats {

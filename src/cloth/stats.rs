@@ -24,9 +24,10 @@ pub struct StepStats {
     pub total: f64,
     /// Conjugate-gradient iterations (0 for explicit steps).
     pub cg_iterations: u32,
-    /// Final relative residual ‖S(b − AΔv)‖ / ‖S(b − Az)‖.
+    /// Final relative residual ‖S(b − AΔv)‖ / ‖S(b − Az)‖, recomputed from the matrix (the
+    /// true residual, not the iteration's recurrence; the worst substep's for a split step).
     pub residual: f64,
-    /// Whether the solve reached the tolerance.
+    /// Whether the true residual met the tolerance (every substep's, for a split step).
     pub converged: bool,
     /// Time spent assembling forces and the matrix (ms).
     pub assemble_ms: f64,
@@ -47,9 +48,12 @@ pub struct StepStats {
     pub penetrating: usize,
     /// Intersecting (edge, triangle) pairs of the cloth at the end of the step.
     pub intersections: usize,
+    /// Times the step failed its checks and was retried split in halves (0: taken whole; k:
+    /// taken as 2^k substeps).
+    pub retries: u32,
 }
 
-const HEADER: &str = "step,time,kinetic,gravity,elastic,total,cg_iterations,residual,converged,assemble_ms,solve_ms,step_ms,collision_ms,contacts,self_contacts,min_distance,penetrating,intersections";
+const HEADER: &str = "step,time,kinetic,gravity,elastic,total,cg_iterations,residual,converged,assemble_ms,solve_ms,step_ms,collision_ms,contacts,self_contacts,min_distance,penetrating,intersections,retries";
 
 fn write_atomic(path: &Path, body: &[u8]) -> Result<(), ClothError> {
     let err = |e: std::io::Error| ClothError::Output {
@@ -73,7 +77,7 @@ pub fn write_csv(path: &Path, stats: &[StepStats]) -> Result<(), ClothError> {
     s.push('\n');
     for r in stats {
         s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             r.step,
             r.time,
             r.kinetic,
@@ -95,7 +99,8 @@ pub fn write_csv(path: &Path, stats: &[StepStats]) -> Result<(), ClothError> {
                 String::new()
             },
             r.penetrating,
-            r.intersections
+            r.intersections,
+            r.retries
         ));
     }
     write_atomic(path, s.as_bytes())

@@ -31,8 +31,12 @@ pub struct PcgResult {
     pub iterations: u32,
     /// Final relative residual ‖S(b − AΔv)‖ / ‖S(b − Az)‖.
     pub residual: f64,
-    /// Whether `residual ≤ tolerance`.
+    /// Whether `residual ≤ tolerance`, as the recurrence of the iteration sees it (the step
+    /// checks the true residual, see [`PcgWorkspace::true_residual`]).
     pub converged: bool,
+    /// The norm of the right-hand side the residual is relative to, ‖S(b − Az)‖ (infinite or
+    /// NaN when the system overflowed).
+    pub rhs_norm: f64,
 }
 
 impl PcgWorkspace {
@@ -159,7 +163,51 @@ impl PcgWorkspace {
             iterations: it,
             residual,
             converged: rr <= target,
+            rhs_norm: bnorm2.sqrt(),
         }
+    }
+
+    /// The true residual of `dv`, recomputed from the matrix rather than carried by the
+    /// iteration's recurrence (one product with `a`): stores `b − A dv` (unfiltered: in the
+    /// constrained directions it is minus the constraint impulse) for [`Self::residual`] and
+    /// returns `‖S(b − A dv)‖`, summed in a fixed order (deterministic). NaN or infinite when
+    /// the system holds a non-finite or overflowing value.
+    pub fn true_residual(&mut self, a: &Bcsr3, b: &[Vec3], filter: &Filter, dv: &[Vec3]) -> f64 {
+        let nc = chunks(b.len(), CHUNK);
+        let p = &mut self.p2[..nc];
+        unfiltered_residual(a, filter, b, dv, &mut self.r, p);
+        ordered_sum(p).sqrt()
+    }
+
+    /// `b − A dv` of the last [`Self::true_residual`].
+    pub fn residual(&self) -> &[Vec3] {
+        &self.r
+    }
+}
+
+multiversion! {
+    /// `r = b − A x` and, per chunk of rows, `Σ ‖S r_i‖²` into `p`.
+    fn unfiltered_residual(
+        a: &Bcsr3,
+        filter: &Filter,
+        b: &[Vec3],
+        x: &[Vec3],
+        r: &mut [Vec3],
+        p: &mut [f64],
+    ) {
+        r.par_chunks_mut(CHUNK)
+            .zip(p.par_iter_mut())
+            .enumerate()
+            .for_each(|(ci, (rs, pr))| {
+                let mut rr = 0.0;
+                for k in 0..rs.len() {
+                    let i = ci * CHUNK + k;
+                    let ri = b[i] - a.row_times_any(i, x);
+                    rr += filter.apply(i, ri).norm_squared();
+                    rs[k] = ri;
+                }
+                *pr = rr;
+            });
     }
 }
 
