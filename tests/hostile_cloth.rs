@@ -170,20 +170,20 @@ fn release_of_an_index_past_the_cloth_is_an_error() {
 #[test]
 fn cloth_grid_of_1e6_by_1e6_is_refused_before_allocating() {
     let e = case_error("cloth_grid_1e6", &[]);
-    assert_has(&e, &["nx × ny", "1000000000000", "max_particles"]);
+    assert_has(&e, &["nx × ny", "is 1e12,", "max_particles"]);
 }
 
 #[test]
 fn cloth_cone_of_1e5_by_1e5_is_refused_before_allocating() {
     let e = case_error("cloth_cone_1e5", &[]);
-    assert_has(&e, &["n_around × n_down", "10000000000", "max_particles"]);
+    assert_has(&e, &["n_around × n_down", "is 1e10,", "max_particles"]);
 }
 
 #[test]
 fn cloth_patch_of_1000_m_at_1_mm_does_not_hang() {
     // 10⁶ m² / (10⁻⁶ m² · √3/2) ≈ 1.15e12 vertices
     let e = case_error("cloth_patch_1000m", &[]);
-    assert_has(&e, &["estimated vertex count", "1154", "max_particles"]);
+    assert_has(&e, &["estimated vertex count", "is 1.1547", "max_particles"]);
 }
 
 #[test]
@@ -234,7 +234,7 @@ fn bench_of_100000_by_100000_is_refused_before_building() {
     let e = emilion::bench::bench_scene("hang", 100_000, 1, 1).unwrap_err();
     assert_has(
         &e.to_string(),
-        &["bench size", "10000000000", "max_particles"],
+        &["bench size", "is 1e10,", "max_particles"],
     );
     let e = emilion::bench::bench_scene("hang", 8, u32::MAX, 1).unwrap_err();
     assert_has(&e.to_string(), &["bench frames", "max_frames"]);
