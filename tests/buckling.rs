@@ -356,12 +356,15 @@ fn flat_triangle_mesh_pushed_from_one_border_is_released_by_both_models() {
         field(ck, "mean over the run") < 0.25 * field(none, "mean over the run"),
         "{none}\n{ck}"
     );
-    // regression: both models end with less spring energy than the mesh without a model. A
-    // flat cloth's ties were drawn for each particle (release) or connection (Choi–Ko) on
-    // its own, so neighbours bulged opposite ways and the mesh ended creased: release
-    // 0.0074 J, Choi–Ko 4.5e-4 J, no model 4.2e-4 J. One side per step: 1.0e-4 and 2.5e-4 J.
+    // regression: both models end with less spring energy than the creased mesh. A flat
+    // cloth's ties were drawn for each particle (release) or connection (Choi–Ko) on its own,
+    // so neighbours bulged opposite ways and the mesh ended creased: release 0.0074 J,
+    // Choi–Ko 4.5e-4 J. One side per step: 1.0e-4 and 2.5e-4 J. The bound is the 4.2e-4 J the
+    // run without a model ended with while its snap out of the plane blew up (2.85 J → 91.9 J
+    // in three steps); the step guard (issue 48) now retries that step in substeps, so that
+    // run is no longer a reference.
     for x in [ck, rel] {
-        assert!(field(x, "elastic") < field(none, "elastic"), "{none}\n{x}");
+        assert!(field(x, "elastic") < 4.2e-4, "{none}\n{x}");
     }
     assert!(dir.join("mesh_energy.png").exists() && dir.join("mesh_release_24.png").exists());
 }

@@ -183,7 +183,10 @@ fn cloth_cone_of_1e5_by_1e5_is_refused_before_allocating() {
 fn cloth_patch_of_1000_m_at_1_mm_does_not_hang() {
     // 10⁶ m² / (10⁻⁶ m² · √3/2) ≈ 1.15e12 vertices
     let e = case_error("cloth_patch_1000m", &[]);
-    assert_has(&e, &["estimated vertex count", "is 1.1547", "max_particles"]);
+    assert_has(
+        &e,
+        &["estimated vertex count", "is 1.1547", "max_particles"],
+    );
 }
 
 #[test]
@@ -232,10 +235,7 @@ fn dress_at_edge_length_1e_5_is_refused_before_meshing() {
 #[test]
 fn bench_of_100000_by_100000_is_refused_before_building() {
     let e = emilion::bench::bench_scene("hang", 100_000, 1, 1).unwrap_err();
-    assert_has(
-        &e.to_string(),
-        &["bench size", "is 1e10,", "max_particles"],
-    );
+    assert_has(&e.to_string(), &["bench size", "is 1e10,", "max_particles"]);
     let e = emilion::bench::bench_scene("hang", 8, u32::MAX, 1).unwrap_err();
     assert_has(&e.to_string(), &["bench frames", "max_frames"]);
 }
