@@ -1,5 +1,5 @@
 //! `Simulation`: a cloth model, its state, constraints and step stages, stepped by the
-//! implicit (Baraff–Witkin, [`implicit`]) or the explicit (symplectic Euler) integrator. Every
+//! implicit (Baraff–Witkin, `simulation/implicit.rs`) or the explicit (symplectic Euler) integrator. Every
 //! step checks for divergence and leaves the state untouched when it fails; an implicit step
 //! is guarded further ([`super::step_guard`]) and retried smaller when it fails.
 

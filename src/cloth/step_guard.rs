@@ -187,7 +187,7 @@ pub fn check_pins(attachments: &[Attachment], x: &[Vec3], t: f64, size: f64) -> 
         let d = at.trajectory.displacement(t);
         for (k, &i) in at.particles.iter().enumerate() {
             let off = (x[i] - (Vec3::from(at.anchors[k]) + d)).norm();
-            if !(off <= tol) {
+            if off.is_nan() || off > tol {
                 return Err(format!(
                     "particle {i} left its pin (or attachment) by {off:.3e} m (tolerance {tol:.1e} m)"
                 ));
@@ -205,7 +205,7 @@ pub fn most_stretched(model: &ClothModel, x: &[Vec3]) -> Option<(usize, usize, f
             continue;
         }
         let stretch = (x[s.b] - x[s.a]).norm() / s.rest - 1.0;
-        if worst.is_none_or(|w| !(stretch <= w.2)) {
+        if worst.is_none_or(|w| stretch.is_nan() || stretch > w.2) {
             worst = Some((s.a, s.b, stretch));
         }
     }
@@ -216,8 +216,10 @@ pub fn most_stretched(model: &ClothModel, x: &[Vec3]) -> Option<(usize, usize, f
 pub fn check_strain(model: &ClothModel, x: &[Vec3]) -> Result<(), String> {
     let limit2 = (1.0 + MAX_STRETCH) * (1.0 + MAX_STRETCH);
     let over = model.springs.iter().any(|s| {
-        matches!(s.kind, SpringKind::Stretch { .. })
-            && !((x[s.b] - x[s.a]).norm_squared() <= limit2 * s.rest * s.rest)
+        matches!(s.kind, SpringKind::Stretch { .. }) && {
+            let l2 = (x[s.b] - x[s.a]).norm_squared();
+            l2.is_nan() || l2 > limit2 * s.rest * s.rest
+        }
     });
     if !over {
         return Ok(());
