@@ -1,7 +1,8 @@
 //! Automatic pre-positioning of the puppet from the images alone (no approximate joints):
 //! the person is found as the visual hull of the cameras' silhouettes
 //! ([`super::visual_hull`]), the puppet is stood at its centre with its feet on its lowest
-//! point, turned to each of [`HEADINGS`] headings, and the best-fitting headings are
+//! point, turned to each of [`HEADINGS`] headings and raised or lowered (an occluder over
+//! the legs in two cameras carves the feet off the hull), and the best-fitting headings are
 //! refined by the tracker's own annealing from coarse to fine, every limb stage also
 //! starting from a small library of limb poses ([`limb_library`]). The same search, seeded
 //! by the last good pose and scored with the learnt colours, finds the body again after a
@@ -182,8 +183,18 @@ impl Tracker {
         let mut scored: Vec<(f64, f64, Vec<f64>)> = (0..HEADINGS)
             .map(|h| {
                 let turn = h as f64 * std::f64::consts::TAU / HEADINGS as f64;
-                let p = self.placed(&base, turn, &found);
-                (self.image_cost(&p, 1), turn, p)
+                let placed = self.placed(&base, turn, &found);
+                // the hull's lowest point is the feet's only where no occluder hides
+                // them from two cameras; the silhouettes decide the height
+                (-12..=4)
+                    .map(|i| {
+                        let mut p = placed.clone();
+                        p[2] += 0.05 * i as f64;
+                        self.puppet().clamp(&mut p);
+                        (self.image_cost(&p, 1), turn, p)
+                    })
+                    .min_by(|a, b| a.0.total_cmp(&b.0))
+                    .unwrap_or((f64::INFINITY, turn, placed))
             })
             .collect();
         scored.sort_by(|a, b| a.0.total_cmp(&b.0));
