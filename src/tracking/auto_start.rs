@@ -27,7 +27,7 @@ const MAX_CELLS: f64 = 4.0e6;
 /// Headings tried, evenly around the vertical.
 pub const HEADINGS: usize = 16;
 /// Headings refined by annealing (the best of the coarse scores, at least 60° apart).
-const REFINED: usize = 3;
+const REFINED: usize = 4;
 /// Spread factors of the annealing passes that refine a heading (wide, then narrower).
 const PASSES: [f64; 4] = [3.0, 1.5, 0.7, 0.35];
 
@@ -44,7 +44,8 @@ pub struct Found {
 
 /// Limb poses tried by every limb stage of the search: upper arm raised back, not, forward
 /// and up, in the body plane or abducted either way, elbow straight or bent; thigh back,
-/// not, forward or high, abducted or not, knee straight or bent. Each vector sets both sides
+/// back, forward or high, not abducted (an abducted pair of legs turned a quarter turn
+/// mimics a stride), knee straight or bent. Each vector sets both sides
 /// the same (the right side's limits mirror the left's, so `side` values of both signs
 /// cover both); only the searched stage's entries are used.
 pub fn limb_library(puppet: &Puppet) -> Vec<Vec<f64>> {
@@ -68,8 +69,10 @@ pub fn limb_library(puppet: &Puppet) -> Vec<Vec<f64>> {
                 set(&mut p, "lowerarm01", "flex", bent);
                 // legs: the same count of combinations, enumerated alongside
                 let (thigh, abduct, knee) = (
-                    [-0.4, 0.0, 0.7, 1.5][i / 6],
-                    [0.0, 0.5, -0.5][(i / 2) % 3],
+                    [
+                        -0.5, -0.35, -0.2, 0.0, 0.15, 0.3, 0.45, 0.6, 0.75, 0.9, 1.2, 1.5,
+                    ][i / 2],
+                    0.0,
                     [0.0, -1.2][i % 2],
                 );
                 set(&mut p, "upperleg01", "flex", thigh);
@@ -137,7 +140,13 @@ impl Tracker {
             Ok(g) => g,
             Err(p) => p.into_inner(),
         };
-        pose_cost(&app, &self.views, level.min(self.views.levels() - 1), params, &mut ws)
+        pose_cost(
+            &app,
+            &self.views,
+            level.min(self.views.levels() - 1),
+            params,
+            &mut ws,
+        )
     }
 
     /// `pose` turned by `turn` about the vertical through its pelvis and moved so the pelvis
@@ -210,8 +219,8 @@ impl Tracker {
                 turns.push(*turn);
             }
         }
-        let prior = self.options.prior_weight;
-        self.options.prior_weight = 0.0;
+        // each pass's motion prior is centred on where the pass starts: large limb moves
+        // must buy their cost in the images
         self.extra_seeds = limb_library(self.puppet());
         let mut best = (Vec::new(), f64::INFINITY);
         for start in picked {
@@ -225,7 +234,6 @@ impl Tracker {
             }
         }
         self.extra_seeds.clear();
-        self.options.prior_weight = prior;
         Ok(best)
     }
 

@@ -158,12 +158,7 @@ pub fn write_status_csv(out: &Path, result: &TrackResult) -> Result<PathBuf, Tra
     for (k, st) in result.status.iter().enumerate() {
         let o = result.overlaps.get(k).copied().unwrap_or(f64::NAN);
         let c = result.costs.get(k).copied().unwrap_or(f64::NAN);
-        let _ = writeln!(
-            s,
-            "{},{},{o:.4},{c:.4}",
-            result.first_frame + k,
-            st.word()
-        );
+        let _ = writeln!(s, "{},{},{o:.4},{c:.4}", result.first_frame + k, st.word());
     }
     std::fs::write(&path, s).map_err(io(&path))?;
     Ok(path)

@@ -38,8 +38,7 @@ impl Hull {
 
     /// Centroid of the cells, `None` when empty.
     pub fn centroid(&self) -> Option<Vec3> {
-        (!self.cells.is_empty())
-            .then(|| self.cells.iter().sum::<Vec3>() / self.cells.len() as f64)
+        (!self.cells.is_empty()).then(|| self.cells.iter().sum::<Vec3>() / self.cells.len() as f64)
     }
 
     /// Lowest cell height (metres), `None` when empty.
@@ -77,7 +76,14 @@ impl Hull {
             while let Some(i) = stack.pop() {
                 size += 1;
                 let k = key(&self.cells[i]);
-                for d in [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]] {
+                for d in [
+                    [1, 0, 0],
+                    [-1, 0, 0],
+                    [0, 1, 0],
+                    [0, -1, 0],
+                    [0, 0, 1],
+                    [0, 0, -1],
+                ] {
                     let n = [k[0] + d[0], k[1] + d[1], k[2] + d[2]];
                     if let Some(&j) = index.get(&n) {
                         if label[j] == usize::MAX {
