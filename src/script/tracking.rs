@@ -220,7 +220,7 @@ default 0.05), `limb_restarts` (limb stages also start from the previous,
 the rest, a half-bent and a straightened limb pose; default true), `seed`, `frames` (track only the first
 frames), `init` (`joints`: start from `init_joints.csv`; `auto`: find the person and
 the pose from the first frame's images alone), `first_frame` (start there; needs `init: \"auto\"`),
-`recover` (notice a lost track and search the body again; default true), `passes` (spread factor of each pass of the stage hierarchy per frame, e.g. [1.0, 0.35]),
+`recover` (notice a lost track and search the body again; default false), `passes` (spread factor of each pass of the stage hierarchy per frame, e.g. [1.0, 0.35]),
 `overlay_every` (0: no pictures), `makehuman` (folder of the body model).",
         |seq: &str, out: &str, m: Map| track(seq, out, &m)
     );

@@ -79,7 +79,7 @@ pub struct TrackerOptions {
     /// frame's images alone ([`super::auto_start`]); `init_joints.csv` is not read.
     pub auto_start: bool,
     /// Notice a lost track from the image fit and find the body again
-    /// ([`super::loss`]).
+    /// ([`super::loss`]); off by default until measured on the dance clips.
     pub recover: bool,
     /// First frame tracked (the start is made there).
     pub first_frame: usize,
@@ -101,7 +101,7 @@ impl Default for TrackerOptions {
             prior_weight: 0.05,
             limb_restarts: true,
             auto_start: false,
-            recover: true,
+            recover: false,
             first_frame: 0,
         }
     }
