@@ -99,7 +99,8 @@ fn track(seq_dir: &str, out: &str, m: &Map) -> RResult<Map> {
     let mh =
         read_folder_opt(makehuman.as_deref())?.unwrap_or_else(|| data_path("bodies/makehuman"));
     let mannequin = Mannequin::load_makehuman(&mh).map_err(rt_err)?;
-    let total = options.frames.map_or(seq.frames, |f| f.min(seq.frames));
+    let available = seq.frames.saturating_sub(options.first_frame);
+    let total = options.frames.map_or(available, |f| f.min(available));
     let bar = std::io::stderr()
         .is_terminal()
         .then(|| ProgressBar::new(total as u64));
