@@ -9,9 +9,9 @@ use std::path::{Path, PathBuf};
 use emilion::script::run_file;
 use emilion::tracking::cost::{FrameViews, Robust};
 use emilion::tracking::pyramid::Level;
+use emilion::tracking::sequence_files::{read_joints_csv, Sequence};
 use emilion::tracking::tracker::{changing_pixels, TrackerOptions};
 use emilion::tracking::visual_hull::{search_box, visual_hull, MIN_PERSON_VOLUME};
-use emilion::tracking::sequence_files::{read_joints_csv, Sequence};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -146,8 +146,14 @@ fn the_visual_hull_stands_where_the_walker_does() {
     let (centre, volume) = (hull.centroid().unwrap(), hull.volume());
     let pelvis = s.ground_truth.as_ref().unwrap()[0][0];
     let d = centre - pelvis;
-    println!("hull: {volume:.3} m³, centre off the pelvis by {:.0?} mm", d * 1000.0);
-    assert!(d.xy().norm() <= 0.12, "hull centre off the pelvis by {d:?} m");
+    println!(
+        "hull: {volume:.3} m³, centre off the pelvis by {:.0?} mm",
+        d * 1000.0
+    );
+    assert!(
+        d.xy().norm() <= 0.12,
+        "hull centre off the pelvis by {d:?} m"
+    );
     // a person: more than the start's minimum, less than a car
     assert!((MIN_PERSON_VOLUME..2.0).contains(&volume), "{volume} m³");
     let _ = std::fs::remove_dir_all(&dir);
