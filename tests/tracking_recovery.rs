@@ -78,9 +78,11 @@ fn errors(seq: &Path, out: &Path) -> Vec<f64> {
         .collect()
 }
 
-/// Ignored: 31 s of CPU (75 s wall on the shared machine) for the start alone, over the
-/// suite's budget; and not yet passing (measured on 2026-12-06 with this 4-frame sequence:
-/// pelvis off by (−110, −112, +58) mm, MPJPE 284 and 288 mm). Run with
+/// The sequence is made 40 frames long, as measured in docs/body-tracking.md: the pixels
+/// the sequence never changes are unknown to the hull and the cost, and with 4 frames made
+/// too much of the floor was (pelvis off by (−110, −112, +58) mm, MPJPE 284 and 288 mm).
+/// Ignored: 32 s of CPU (150 s wall on the shared machine) for the start alone, over the
+/// suite's budget. Run with
 /// `cargo test --release --test tracking_recovery -- --ignored automatic_start`.
 /// The fast check that the person is found is
 /// `the_visual_hull_stands_where_the_walker_does`.
@@ -92,7 +94,7 @@ fn automatic_start_finds_the_walker_without_init_joints() {
     };
     let dir = temp("auto");
     let (seq, out) = (dir.join("seq"), dir.join("track"));
-    make(&motion, &seq, 4);
+    make(&motion, &seq, 40);
     // the automatic start must not read it
     std::fs::remove_file(seq.join("init_joints.csv")).unwrap();
     track(&seq, &out, &[("init", "auto"), ("frames", "2")]).unwrap();
