@@ -13,6 +13,8 @@
 
 use std::collections::VecDeque;
 
+pub use super::frame_status::FrameStatus;
+
 use super::cost::Appearance;
 use super::tracker::Tracker;
 use super::visual_hull::FOREGROUND_RHO;
@@ -20,45 +22,6 @@ use crate::render::raster::{draw_triangles, project_vertices};
 
 /// Pyramid level the overlap is measured at.
 const FIT_LEVEL: usize = 1;
-
-/// What happened to a tracked frame.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum FrameStatus {
-    /// Tracked, fit as expected.
-    #[default]
-    Tracked,
-    /// The fit fell: the track is lost (and the search again did not fit well enough).
-    Lost,
-    /// The track was lost and the search again found the body on this frame.
-    Recovered,
-}
-
-impl FrameStatus {
-    /// The word written in the run's CSV.
-    pub fn word(self) -> &'static str {
-        match self {
-            FrameStatus::Tracked => "tracked",
-            FrameStatus::Lost => "lost",
-            FrameStatus::Recovered => "recovered",
-        }
-    }
-
-    /// As a small number (checkpoints).
-    pub fn code(self) -> u8 {
-        self as u8
-    }
-
-    /// From [`code`](Self::code).
-    pub fn from_code(c: u8) -> Option<FrameStatus> {
-        [
-            FrameStatus::Tracked,
-            FrameStatus::Lost,
-            FrameStatus::Recovered,
-        ]
-        .get(c as usize)
-        .copied()
-    }
-}
 
 /// Thresholds of the loss detector.
 #[derive(Clone, Copy, Debug)]

@@ -25,6 +25,7 @@ pub mod clothing;
 pub mod correspondences;
 pub mod cost;
 pub mod dlt;
+pub mod frame_status;
 pub mod joints;
 pub mod loss;
 pub mod overlay;

@@ -131,7 +131,7 @@ pub struct TrackResult {
     /// Overlap of each tracked frame's pose with the foreground ([`Tracker::overlap`]).
     pub overlaps: Vec<f64>,
     /// What happened to each frame (tracked, lost, recovered).
-    pub status: Vec<super::loss::FrameStatus>,
+    pub status: Vec<super::frame_status::FrameStatus>,
     /// Per-frame mean joint error against the ground truth (mm), when present.
     pub errors_mm: Option<Vec<f64>>,
     /// Per-frame, per-joint errors (mm), when the ground truth is present.
@@ -158,7 +158,7 @@ impl TrackResult {
     }
 
     /// The sequence's frames (numbered as in the sequence) whose state is `status`.
-    pub fn frames_with(&self, status: super::loss::FrameStatus) -> Vec<usize> {
+    pub fn frames_with(&self, status: super::frame_status::FrameStatus) -> Vec<usize> {
         (self.status.iter().enumerate())
             .filter(|(_, s)| **s == status)
             .map(|(k, _)| self.first_frame + k)
