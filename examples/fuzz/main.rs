@@ -285,13 +285,15 @@ fn supervise(o: &Options) {
             }
         });
         let mut current: Option<u64> = None;
+        let pid = child.id();
+        let (mut case_wall, mut case_cpu) = (Instant::now(), cpu_seconds(pid));
         loop {
             if deadline.is_some_and(|d| Instant::now() > d) {
                 let _ = child.kill();
                 let _ = child.wait();
                 break 'workers;
             }
-            match rx.recv_timeout(Duration::from_secs_f64(o.timeout_s)) {
+            match rx.recv_timeout(Duration::from_secs_f64(o.timeout_s.min(1.0))) {
                 Ok(Event::Line(line)) => {
                     let mut w = line.splitn(4, ' ');
                     match (w.next(), w.next(), w.next()) {
@@ -300,6 +302,7 @@ fn supervise(o: &Options) {
                                 done += 1;
                             }
                             current = i.parse().ok();
+                            (case_wall, case_cpu) = (Instant::now(), cpu_seconds(pid));
                         }
                         (Some("@@"), Some("p"), Some(i)) => {
                             let i: u64 = i.parse().unwrap_or(0);
@@ -346,10 +349,21 @@ fn supervise(o: &Options) {
                     continue 'workers;
                 }
                 Err(mpsc::RecvTimeoutError::Timeout) => {
+                    // A hang is a case that spends `timeout_s` of the worker's CPU time (or
+                    // HANG_WALL_FACTOR times that in wall time): on a loaded machine a case
+                    // waiting for a core is not hanging.
+                    let cpu = cpu_seconds(pid) - case_cpu;
+                    let wall = case_wall.elapsed().as_secs_f64();
+                    if cpu < o.timeout_s && wall < HANG_WALL_FACTOR * o.timeout_s {
+                        continue;
+                    }
                     let _ = child.kill();
                     let _ = child.wait();
                     let i = current.unwrap_or(next);
-                    let why = format!("no answer within {} s", o.timeout_s);
+                    let why = format!(
+                        "no answer after {cpu:.0} s of CPU time ({wall:.0} s wall; limit {} s of CPU)",
+                        o.timeout_s
+                    );
                     record(o, &target, &seeds, &mut findings, i, "hang", &why);
                     done += 1;
                     next = i + 1;
@@ -375,6 +389,27 @@ fn supervise(o: &Options) {
     for (sig, (n, files)) in sigs {
         eprintln!("  {n:>6} × {sig}\n         saved: {}", files.join(", "));
     }
+}
+
+/// Wall time, as a multiple of the CPU-time limit, after which a case is a hang however little
+/// CPU it got (a worker blocked for ever).
+const HANG_WALL_FACTOR: f64 = 6.0;
+
+/// CPU seconds (user + system) that process `pid` has used, from `/proc/PID/stat`; 0 where that
+/// cannot be read (then only the wall-time bound applies).
+fn cpu_seconds(pid: u32) -> f64 {
+    const TICKS_PER_SECOND: f64 = 100.0; // Linux's USER_HZ on every common platform
+    let Ok(stat) = std::fs::read_to_string(format!("/proc/{pid}/stat")) else {
+        return 0.0;
+    };
+    // the fields after the command name (which may hold spaces) in parentheses
+    let Some(rest) = stat.rsplit_once(')').map(|(_, r)| r) else {
+        return 0.0;
+    };
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    // utime and stime are fields 14 and 15 of the line, 12 and 13 after the name
+    let ticks = |k: usize| f.get(k).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
+    (ticks(11) + ticks(12)) / TICKS_PER_SECOND
 }
 
 fn progress(target: &Target, done: u64, started: Instant, f: &Findings) {

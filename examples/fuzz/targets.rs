@@ -375,8 +375,11 @@ thread_local! {
     };
 }
 
-/// A script: run with `out` set to a scratch folder (every generated script writes there).
+/// A script: run with `out` set to a scratch folder (every generated script writes there), under
+/// a 1 s time budget as `emilion run --max-seconds 1` gives it: a legitimately long run (say
+/// `s.run(1e5)` on a small cloth, 10⁷ steps) must stop at its budget with an error, not hang.
 fn script(data: &[u8]) -> Result<(), String> {
+    emilion::limits::set_deadline(std::time::Duration::from_secs(1));
     let out = std::env::temp_dir().join(format!("emilion-fuzz-{}", std::process::id()));
     let _ = std::fs::create_dir_all(&out);
     let mut scope = rhai::Scope::new();
