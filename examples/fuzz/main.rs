@@ -47,6 +47,7 @@ struct Options {
     image_seeds: Option<PathBuf>,
     worker: bool,
     save_max: usize,
+    print: bool,
 }
 
 fn usage() -> ! {
@@ -54,6 +55,7 @@ fn usage() -> ! {
         "usage: fuzz --reader NAME|all [--cases N] [--seed S] [--start I] [--seconds T]\n\
          \x20           [--timeout-s 10] [--max-alloc-mb 1024] [--corpus tests/fuzz] [--save-max 3]\n\
          \x20      fuzz --reader NAME --replay FILE_OR_DIR\n\
+         \x20      fuzz --reader NAME --seed S --start I --print   (case I's input to stdout)\n\
          readers: {}",
         targets::all()
             .iter()
@@ -78,6 +80,7 @@ fn parse_options() -> Options {
         image_seeds: None,
         worker: false,
         save_max: 3,
+        print: false,
     };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -94,6 +97,7 @@ fn parse_options() -> Options {
             "--replay" => o.replay = Some(PathBuf::from(val())),
             "--save-max" => o.save_max = val().parse().unwrap_or_else(|_| usage()),
             "--worker" => o.worker = true,
+            "--print" => o.print = true,
             "--write-image-seeds" => {
                 o.image_seeds = Some(PathBuf::from(val()));
                 o.reader = "image".into();
@@ -123,7 +127,10 @@ fn main() {
         return;
     }
     let target = targets::by_name(&o.reader).unwrap_or_else(|| usage());
-    if let Some(path) = &o.replay {
+    if o.print {
+        let seeds = seeds(&o.corpus, &target);
+        let _ = std::io::stdout().write_all(&input(&o, &target, &seeds, o.start));
+    } else if let Some(path) = &o.replay {
         replay(&target, path);
     } else if o.worker {
         work(&o, &target);
