@@ -378,8 +378,15 @@ thread_local! {
 /// A script: run with `out` set to a scratch folder (every generated script writes there), under
 /// a 1 s time budget as `emilion run --max-seconds 1` gives it: a legitimately long run (say
 /// `s.run(1e5)` on a small cloth, 10⁷ steps) must stop at its budget with an error, not hang.
+///
+/// It runs under `--limit max_particles=500000` too: the default 4 000 000 particles lets a script
+/// mesh or build a cloth that needs more than the harness's 1 GB cap (case 160194 of seed 1:
+/// `cloth_patch(1.2, 1.21, 0.001)`, 1.7e6 vertices, a 563 MB buffer on top of the mesher's).
 fn script(data: &[u8]) -> Result<(), String> {
     emilion::limits::set_deadline(std::time::Duration::from_secs(1));
+    let mut limits = emilion::limits::get();
+    limits.max_particles = 500_000;
+    emilion::limits::set(limits);
     let out = std::env::temp_dir().join(format!("emilion-fuzz-{}", std::process::id()));
     let _ = std::fs::create_dir_all(&out);
     let mut scope = rhai::Scope::new();
