@@ -23,6 +23,8 @@ pub mod correspondences;
 pub mod cost;
 pub mod dlt;
 pub mod joints;
+pub mod marker_fit;
+pub mod marker_set;
 pub mod overlay;
 pub mod puppet;
 pub mod puppet_mesh;

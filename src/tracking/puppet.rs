@@ -40,6 +40,7 @@ mod fit;
 mod rest;
 
 pub use rest::Proportions;
+pub(crate) use fit::kabsch;
 use rest::{right_of, Segment, KEYS};
 
 /// Number of pose parameters.
