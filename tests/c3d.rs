@@ -13,8 +13,10 @@ fn tiny_c3d(frames: u16, analog: u16, coords: impl Fn(usize, usize) -> [f32; 3])
     let mut b = vec![0u8; 512 * 2];
     b[0] = 2;
     b[1] = 0x50;
-    let w = |b: &mut Vec<u8>, i: usize, v: u16| b[2 * i..2 * i + 2].copy_from_slice(&v.to_le_bytes());
-    let f = |b: &mut Vec<u8>, i: usize, v: f32| b[2 * i..2 * i + 4].copy_from_slice(&v.to_le_bytes());
+    let w =
+        |b: &mut Vec<u8>, i: usize, v: u16| b[2 * i..2 * i + 2].copy_from_slice(&v.to_le_bytes());
+    let f =
+        |b: &mut Vec<u8>, i: usize, v: f32| b[2 * i..2 * i + 4].copy_from_slice(&v.to_le_bytes());
     w(&mut b, 1, 2);
     w(&mut b, 2, analog);
     w(&mut b, 3, 1);
@@ -99,7 +101,10 @@ fn malformed_c3d_files_get_errors_naming_the_file_and_the_fault() {
     let good = tiny_c3d(3, 0, |f, m| [f as f32, m as f32, 1.0]);
     // shorter than a header
     let e = err(&good[..100]);
-    assert!(e.contains("bad.c3d") && e.contains("512-byte header"), "{e}");
+    assert!(
+        e.contains("bad.c3d") && e.contains("512-byte header"),
+        "{e}"
+    );
     // not a C3D key
     let mut b = good.clone();
     b[1] = 0;
@@ -139,7 +144,10 @@ fn malformed_c3d_files_get_errors_naming_the_file_and_the_fault() {
     // NaN coordinate in a valid sample
     let nan = tiny_c3d(3, 0, |f, _| [if f == 2 { f32::NAN } else { 0.0 }, 0.0, 0.0]);
     let e = err(&nan);
-    assert!(e.contains("frame 3") && e.contains("`A`") && e.contains("NaN"), "{e}");
+    assert!(
+        e.contains("frame 3") && e.contains("`A`") && e.contains("NaN"),
+        "{e}"
+    );
     // a parameter whose data runs past the section
     let mut b = good.clone();
     let at = b.windows(5).position(|w| w == b"UNITS").unwrap();

@@ -21,7 +21,9 @@ fn inputs() -> Option<(Mannequin, emilion::body::MarkerTrial)> {
 
 #[test]
 fn the_driver_swing_is_fitted_within_15_mm_rms_and_its_bvh_reads_back() {
-    let Some((mannequin, trial)) = inputs() else { return };
+    let Some((mannequin, trial)) = inputs() else {
+        return;
+    };
     let t0 = std::time::Instant::now();
     let options = MarkerFitOptions {
         calibration_stride: 16,

@@ -210,8 +210,18 @@ pub fn all() -> Vec<Target> {
             ext: "c3d",
             text: false,
             dictionary: &[
-                "POINT", "USED", "SCALE", "RATE", "LABELS", "UNITS", "Y_SCREEN", "\u{50}", "T", "mm",
-                "\u{ff}\u{ff}", "\u{0}\u{0}",
+                "POINT",
+                "USED",
+                "SCALE",
+                "RATE",
+                "LABELS",
+                "UNITS",
+                "Y_SCREEN",
+                "\u{50}",
+                "T",
+                "mm",
+                "\u{ff}\u{ff}",
+                "\u{0}\u{0}",
             ],
             run: c3d,
         },
@@ -358,8 +368,7 @@ fn bvh(data: &[u8]) -> Result<(), String> {
 }
 
 fn c3d(data: &[u8]) -> Result<(), String> {
-    let trial =
-        emilion::body::markers::parse_c3d(data, "fuzz.c3d").map_err(|e| e.to_string())?;
+    let trial = emilion::body::markers::parse_c3d(data, "fuzz.c3d").map_err(|e| e.to_string())?;
     let _ = trial.invalid_count();
     let _ = trial.infer_up();
     if trial.frames > 0 && trial.markers() > 0 {

@@ -160,7 +160,10 @@ impl MarkerFit {
 
 /// Observations of one frame: per fitted marker, its position (engine frame) if valid.
 fn observed(trial: &MarkerTrial, markers: &[FittedMarker], frame: usize) -> Vec<Option<Vec3>> {
-    markers.iter().map(|m| trial.world(frame, m.index)).collect()
+    markers
+        .iter()
+        .map(|m| trial.world(frame, m.index))
+        .collect()
 }
 
 /// Fits `mannequin`'s puppet to `trial` through `set` (see the module docs). Markers of the set
@@ -281,13 +284,20 @@ fn uniform(s: f64) -> Proportions {
 /// The trial's head-top height over its lowest body marker, over the rest set's.
 fn height_ratio(trial: &MarkerTrial, markers: &[FittedMarker]) -> Option<f64> {
     let top = markers.iter().position(|m| m.label == "HeadTop")?;
-    let rest_low = markers.iter().map(|m| m.rest.z).fold(f64::INFINITY, f64::min);
+    let rest_low = markers
+        .iter()
+        .map(|m| m.rest.z)
+        .fold(f64::INFINITY, f64::min);
     let rest_h = markers[top].rest.z - rest_low;
     let mut h: Vec<f64> = (0..trial.frames)
         .filter_map(|f| {
             let o = observed(trial, markers, f);
             let t = o[top]?.z;
-            let low = o.iter().flatten().map(|p| p.z).fold(f64::INFINITY, f64::min);
+            let low = o
+                .iter()
+                .flatten()
+                .map(|p| p.z)
+                .fold(f64::INFINITY, f64::min);
             Some(t - low)
         })
         .collect();

@@ -48,8 +48,17 @@ const ARM_RIGHT: usize = 3;
 
 /// Left-side (or midline) entries: label, right label (None on the midline), bone (`.L`
 /// for sided bones), a, b, t, offset.
-type Entry = (&'static str, Option<&'static str>, &'static str, usize, usize, f64, [f64; 3]);
+type Entry = (
+    &'static str,
+    Option<&'static str>,
+    &'static str,
+    usize,
+    usize,
+    f64,
+    [f64; 3],
+);
 
+#[rustfmt::skip]
 const GEARS: [Entry; 16] = [
     ("WaistLeft", Some("WaistRight"), "root", HIP, HIP, 0.0, [0.03, -0.08, 0.08]),
     ("WaistLBack", Some("WaistRBack"), "root", HIP, HIP, 0.0, [0.0, 0.12, 0.10]),

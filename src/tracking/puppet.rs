@@ -39,8 +39,8 @@ mod fit;
 #[path = "puppet_rest.rs"]
 mod rest;
 
-pub use rest::Proportions;
 pub(crate) use fit::kabsch;
+pub use rest::Proportions;
 use rest::{right_of, Segment, KEYS};
 
 /// Number of pose parameters.

@@ -141,9 +141,7 @@ fn read_points(
         lim.max_frames,
     )
     .map_err(|e| bad(e.to_string()))?;
-    let scale = params
-        .number("POINT", "SCALE", false)
-        .unwrap_or(h.scale);
+    let scale = params.number("POINT", "SCALE", false).unwrap_or(h.scale);
     let rate = params.number("POINT", "RATE", false).unwrap_or(h.rate);
     if !scale.is_finite() || scale == 0.0 {
         return Err(bad(format!(

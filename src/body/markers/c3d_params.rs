@@ -153,6 +153,12 @@ fn parse_param(section: &[u8], body: usize, name: &str) -> Result<Param, String>
 /// Bytes as text, non-ASCII bytes replaced.
 fn ascii(b: &[u8]) -> String {
     b.iter()
-        .map(|&c| if c.is_ascii() && c != 0 { c as char } else { ' ' })
+        .map(|&c| {
+            if c.is_ascii() && c != 0 {
+                c as char
+            } else {
+                ' '
+            }
+        })
         .collect()
 }

@@ -12,7 +12,7 @@ mod c3d_params;
 
 pub use c3d::{parse_c3d, read_c3d};
 
-use crate::geometry::export_frame::{ExportFrame, UpAxis, Units};
+use crate::geometry::export_frame::{ExportFrame, Units, UpAxis};
 use crate::geometry::Vec3;
 
 /// A marker trial: `frames × markers` samples, each a position (metres, file axes) and a
