@@ -14,7 +14,7 @@
 use nalgebra::{DMatrix, DVector, Point3};
 
 use super::marker_set::MarkerSet;
-use super::puppet::{Proportions, Puppet, PARAM_COUNT};
+use super::puppet::{Proportions, Puppet, DRIVEN_BONES, PARAM_COUNT};
 use crate::body::{Mannequin, MarkerTrial, Pose};
 use crate::geometry::least_squares::{
     self, DampingUpdate, DiagonalDamping, LeastSquares, Schedule, Tries,
@@ -447,6 +447,8 @@ fn solve_frame(
     if seen.is_empty() {
         return p;
     }
+    let bones: Vec<usize> = markers.iter().map(|m| m.bone).collect();
+    let subset = puppet.with_ancestors(&bones);
     let mut problem = MarkerIk {
         puppet,
         markers,
@@ -455,6 +457,8 @@ fn solve_frame(
         prior: p.clone(),
         pose: Pose::identity(puppet.bone_count()),
         rows: 3 * seen.len() + PARAM_COUNT,
+        active: active_params(puppet, &subset),
+        subset,
     };
     let schedule = Schedule {
         iterations,
@@ -499,6 +503,20 @@ fn rigid_start(puppet: &Puppet, markers: &[FittedMarker], obs: &[Option<Vec3>]) 
     p
 }
 
+/// Which parameters move a bone of `subset` (the marker bones and their ancestors): the root
+/// and the chest and head (whose rotations the spine and neck bones share) always, a limb's
+/// rotation when its bone is in the subset (it turns that bone and those below it only).
+fn active_params(puppet: &Puppet, subset: &[usize]) -> [bool; PARAM_COUNT] {
+    let mut active = [true; PARAM_COUNT];
+    for k in 2..DRIVEN_BONES.len() {
+        let used = puppet
+            .driven_bone(k)
+            .is_some_and(|b| subset.binary_search(&b).is_ok());
+        active[6 + 3 * k..9 + 3 * k].fill(used);
+    }
+    active
+}
+
 /// Inverse kinematics of one frame as a least-squares problem.
 struct MarkerIk<'a> {
     puppet: &'a Puppet,
@@ -508,6 +526,10 @@ struct MarkerIk<'a> {
     prior: Vec<f64>,
     pose: Pose,
     rows: usize,
+    /// The marker bones and their ancestors: the only bones posed.
+    subset: Vec<usize>,
+    /// Parameters that move a marker; the others have only their prior row.
+    active: [bool; PARAM_COUNT],
 }
 
 impl LeastSquares for MarkerIk<'_> {
@@ -521,7 +543,8 @@ impl LeastSquares for MarkerIk<'_> {
         if out.len() != self.rows {
             *out = DVector::zeros(self.rows);
         }
-        self.puppet.pose_into(p, &mut self.pose);
+        self.puppet
+            .pose_subset_into(p, &mut self.pose, &self.subset);
         for (r, &k) in self.seen.iter().enumerate() {
             let x = self.obs[k].unwrap_or_default();
             let e = marker_at(&self.pose, &self.markers[k]) - x;
@@ -536,7 +559,13 @@ impl LeastSquares for MarkerIk<'_> {
     fn jacobian(&mut self, p: &Vec<f64>, r: &DVector<f64>, jac: &mut DMatrix<f64>) {
         let mut q = p.clone();
         let mut r2 = DVector::zeros(self.rows);
+        let o = 3 * self.seen.len();
         for i in 0..PARAM_COUNT {
+            if !self.active[i] {
+                jac.column_mut(i).fill(0.0);
+                jac[(o + i, i)] = PRIOR;
+                continue;
+            }
             q.copy_from_slice(p);
             let h = if p[i] + 1e-6 > self.puppet.params()[i].hi {
                 -1e-6
