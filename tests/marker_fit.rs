@@ -21,12 +21,15 @@ fn inputs() -> Option<(Mannequin, emilion::body::MarkerTrial)> {
 
 #[test]
 fn the_driver_swing_is_fitted_within_15_mm_rms_and_its_bvh_reads_back() {
-    let Some((mannequin, trial)) = inputs() else {
+    let Some((mannequin, full)) = inputs() else {
         return;
     };
+    // every third frame (218 frames at 120 Hz) keeps the test in seconds; the whole trial is
+    // fitted by `scripts/golf_markers.rhai --set every=1` (docs/golf.md)
+    let trial = full.every(3);
     let t0 = std::time::Instant::now();
     let options = MarkerFitOptions {
-        calibration_stride: 16,
+        calibration_stride: 8,
         rounds: 3,
         ..MarkerFitOptions::default()
     };
@@ -34,23 +37,23 @@ fn the_driver_swing_is_fitted_within_15_mm_rms_and_its_bvh_reads_back() {
     eprintln!("fit in {:.1} s", t0.elapsed().as_secs_f64());
     eprintln!("{}", fit.residual_csv());
     eprintln!("{:?}", fit.puppet.proportions());
-    assert_eq!(fit.params.len(), 654);
+    assert_eq!(fit.params.len(), 218);
     // 28 body markers of the set (the club and unnamed points are not on the body)
     assert_eq!(fit.markers.len(), 28);
     let rms = fit.rms();
     assert!(rms <= 0.015, "residual RMS {:.2} mm", rms * 1e3);
     let csv = fit.residual_csv();
     assert_eq!(csv.lines().count(), 1 + 28 + 1);
-    // RShoulderTop is missing in most frames: 128 valid samples of 654
-    assert!(csv.contains("RShoulderTop,128,"));
+    // RShoulderTop is missing in most frames: 42 valid samples of 218 (128 of 654)
+    assert!(csv.contains("RShoulderTop,42,"));
 
     // BVH round trip: written, read back by the BVH reader, written again: the same channels
     let joints = fit.joints();
     let rest = fit.puppet.rest_joints();
     let text = to_bvh_string(&joints, trial.rate, Some(&rest)).unwrap();
     let motion = Motion::parse_bvh(&text, "fit.bvh").unwrap();
-    assert_eq!(motion.frame_count(), 654);
-    assert!((motion.frame_time() - 1.0 / 360.0).abs() < 1e-6);
+    assert_eq!(motion.frame_count(), 218);
+    assert!((motion.frame_time() - 1.0 / 120.0).abs() < 1e-6);
     let written: Vec<Vec<f64>> = text
         .lines()
         .skip_while(|l| !l.starts_with("Frame Time"))

@@ -59,6 +59,31 @@ impl MarkerTrial {
         }
     }
 
+    /// Every `step`-th frame from frame 0 (rate divided by `step`; `step` 0 counts as 1): a
+    /// shorter trial for quick fits.
+    pub fn every(&self, step: usize) -> MarkerTrial {
+        let step = step.max(1);
+        let m = self.labels.len();
+        let keep: Vec<usize> = (0..self.frames).step_by(step).collect();
+        let pick = |v: &[f64]| -> Vec<f64> {
+            keep.iter()
+                .flat_map(|&f| v[f * m..(f + 1) * m].iter().copied())
+                .collect()
+        };
+        MarkerTrial {
+            source: self.source.clone(),
+            labels: self.labels.clone(),
+            rate: self.rate / step as f64,
+            frames: keep.len(),
+            positions: keep
+                .iter()
+                .flat_map(|&f| self.positions[f * m..(f + 1) * m].iter().copied())
+                .collect(),
+            residuals: pick(&self.residuals),
+            up: self.up,
+        }
+    }
+
     /// Number of markers.
     pub fn markers(&self) -> usize {
         self.labels.len()
