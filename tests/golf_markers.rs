@@ -65,7 +65,7 @@ fn a_plane_through_a_tilted_circle_has_its_tilt() {
         "{}",
         p.inclination_deg
     );
-    assert!(p.rms < 1e-12);
+    assert!(p.rms < 1e-6, "{}", p.rms);
     assert!(fit_plane(&pts[..2]).is_none());
 }
 
