@@ -117,6 +117,7 @@ fn other_scripts_run() {
             "buckle_sleeve",
             "make_sequence",
             "track_body",
+            "golf_markers",
             "make_face_sequence",
             "face_track",
             "face_fit",

@@ -206,6 +206,26 @@ pub fn all() -> Vec<Target> {
             run: bvh,
         },
         Target {
+            name: "c3d",
+            ext: "c3d",
+            text: false,
+            dictionary: &[
+                "POINT",
+                "USED",
+                "SCALE",
+                "RATE",
+                "LABELS",
+                "UNITS",
+                "Y_SCREEN",
+                "\u{50}",
+                "T",
+                "mm",
+                "\u{ff}\u{ff}",
+                "\u{0}\u{0}",
+            ],
+            run: c3d,
+        },
+        Target {
             name: "pts",
             ext: "pts",
             text: true,
@@ -344,6 +364,16 @@ fn bvh(data: &[u8]) -> Result<(), String> {
         let _ = motion.joint_positions(f);
     }
     let _ = motion.duration();
+    Ok(())
+}
+
+fn c3d(data: &[u8]) -> Result<(), String> {
+    let trial = emilion::body::markers::parse_c3d(data, "fuzz.c3d").map_err(|e| e.to_string())?;
+    let _ = trial.invalid_count();
+    let _ = trial.infer_up();
+    if trial.frames > 0 && trial.markers() > 0 {
+        let _ = trial.world(trial.frames - 1, trial.markers() - 1);
+    }
     Ok(())
 }
 

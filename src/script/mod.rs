@@ -33,6 +33,7 @@ pub mod facade;
 pub mod facade_analysis;
 pub mod face;
 pub mod garment;
+pub mod golf;
 pub mod imports;
 pub mod kes;
 pub mod measure;
@@ -181,6 +182,7 @@ pub fn build_engine_with(limits: EngineLimits) -> Engine {
     facade::register(&mut engine);
     facade_analysis::register(&mut engine);
     tracking::register(&mut engine);
+    golf::register(&mut engine);
     face::register(&mut engine);
     tracking_sequence::register(&mut engine);
     kes::register(&mut engine);

@@ -20,7 +20,7 @@ const TRUNK: [usize; 7] = [0, 1, 2, 4, 7, 10, 13];
 const PRIOR: f64 = 0.01;
 
 /// Best rigid motion `x ↦ r x + t` taking the first points onto the second (Kabsch).
-fn kabsch(pairs: &[(Vec3, Vec3)]) -> Option<(UnitQuaternion<f64>, Vec3)> {
+pub(crate) fn kabsch(pairs: &[(Vec3, Vec3)]) -> Option<(UnitQuaternion<f64>, Vec3)> {
     let n = pairs.len() as f64;
     let ca = pairs.iter().map(|p| p.0).sum::<Vec3>() / n;
     let cb = pairs.iter().map(|p| p.1).sum::<Vec3>() / n;
