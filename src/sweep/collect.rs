@@ -139,18 +139,42 @@ pub fn collect(sweep: &Sweep) -> Result<Collected, SweepError> {
     let mut header = vec!["id".to_string(), "status".to_string()];
     header.extend(param_keys.iter().cloned());
     header.extend(keys.iter().cloned());
-    let mut csv = header.iter().map(|h| csv_field(h)).collect::<Vec<_>>().join(",") + "\n";
+    let mut csv = header
+        .iter()
+        .map(|h| csv_field(h))
+        .collect::<Vec<_>>()
+        .join(",")
+        + "\n";
     let mut md_rows = String::new();
     for (run, row) in sweep.runs.iter().zip(&rows) {
-        let params: BTreeMap<&str, &str> =
-            run.sets.iter().map(|(k, v)| (k.as_str(), v.as_str())).collect();
+        let params: BTreeMap<&str, &str> = run
+            .sets
+            .iter()
+            .map(|(k, v)| (k.as_str(), v.as_str()))
+            .collect();
         let mut cells = vec![run.id.clone(), row.status.to_string()];
-        cells.extend(param_keys.iter().map(|k| params.get(k.as_str()).unwrap_or(&"").to_string()));
-        cells.extend(keys.iter().map(|k| row.values.get(k).cloned().unwrap_or_default()));
-        csv += &(cells.iter().map(|c| csv_field(c)).collect::<Vec<_>>().join(",") + "\n");
+        cells.extend(
+            param_keys
+                .iter()
+                .map(|k| params.get(k.as_str()).unwrap_or(&"").to_string()),
+        );
+        cells.extend(
+            keys.iter()
+                .map(|k| row.values.get(k).cloned().unwrap_or_default()),
+        );
+        csv += &(cells
+            .iter()
+            .map(|c| csv_field(c))
+            .collect::<Vec<_>>()
+            .join(",")
+            + "\n");
         md_rows += &format!(
             "| {} |\n",
-            cells.iter().map(|c| md_field(c)).collect::<Vec<_>>().join(" | ")
+            cells
+                .iter()
+                .map(|c| md_field(c))
+                .collect::<Vec<_>>()
+                .join(" | ")
         );
     }
     let csv_path = dir.join("results.csv");
@@ -179,7 +203,14 @@ pub fn collect(sweep: &Sweep) -> Result<Collected, SweepError> {
         md += "\n";
     }
     md += "## Runs\n\n";
-    md += &format!("| {} |\n", header.iter().map(|h| md_field(h)).collect::<Vec<_>>().join(" | "));
+    md += &format!(
+        "| {} |\n",
+        header
+            .iter()
+            .map(|h| md_field(h))
+            .collect::<Vec<_>>()
+            .join(" | ")
+    );
     md += &format!("|{}\n", "---|".repeat(header.len()));
     md += &md_rows;
     let md_path = dir.join("summary.md");
@@ -250,7 +281,12 @@ fn plots(sweep: &Sweep, rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>, SweepE
     for p in &sweep.manifest.collect.plot {
         let mut series: BTreeMap<String, Vec<[f64; 2]>> = BTreeMap::new();
         for (run, row) in sweep.runs.iter().zip(rows) {
-            let param = |k: &str| run.sets.iter().find(|(kk, _)| kk == k).map(|(_, v)| v.clone());
+            let param = |k: &str| {
+                run.sets
+                    .iter()
+                    .find(|(kk, _)| kk == k)
+                    .map(|(_, v)| v.clone())
+            };
             let x = param(&p.x).and_then(|v| v.parse::<f64>().ok());
             let y = row.values.get(&p.y).and_then(|v| v.parse::<f64>().ok());
             let (Some(x), Some(y)) = (x, y) else { continue };
@@ -281,7 +317,8 @@ fn plots(sweep: &Sweep, rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>, SweepE
         };
         let stem = dir.join("plots").join(format!("{}_vs_{}", p.y, p.x));
         std::fs::create_dir_all(dir.join("plots")).map_err(SweepError::io(dir.join("plots")))?;
-        let (png, svg) = write_plot_pair(&stem, &spec).map_err(|e| SweepError::Other(e.to_string()))?;
+        let (png, svg) =
+            write_plot_pair(&stem, &spec).map_err(|e| SweepError::Other(e.to_string()))?;
         out.push(png);
         out.push(svg);
     }

@@ -154,7 +154,9 @@ fn axes(m: &Manifest) -> Result<Vec<Axis>, SweepError> {
                 message: e.to_string(),
             }
         })?;
-        let vs: Vec<String> = (0..s.count as i64).map(|i| (s.start + i).to_string()).collect();
+        let vs: Vec<String> = (0..s.count as i64)
+            .map(|i| (s.start + i).to_string())
+            .collect();
         axes.push(plain(&s.name, &vs));
     }
     Ok(axes)

@@ -74,8 +74,10 @@ pub fn run_local(sweep: &Sweep, opts: &LocalOptions) -> Result<LocalSummary, Swe
         ProgressBar::hidden()
     };
     bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} runs, {elapsed} elapsed, ETA {eta} {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} runs, {elapsed} elapsed, ETA {eta} {msg}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let next = AtomicUsize::new(0);
     let results: Mutex<Vec<(usize, RunState)>> = Mutex::new(Vec::new());
@@ -102,10 +104,8 @@ pub fn run_local(sweep: &Sweep, opts: &LocalOptions) -> Result<LocalSummary, Swe
     let mut results = results.into_inner().unwrap_or_default();
     results.sort_by_key(|r| r.0);
     summary.ran = results.len();
-    let mut failed: Vec<(usize, String)> = left_failed
-        .into_iter()
-        .map(|(r, s)| (r.index, s))
-        .collect();
+    let mut failed: Vec<(usize, String)> =
+        left_failed.into_iter().map(|(r, s)| (r.index, s)).collect();
     for (i, state) in results {
         match state {
             RunState::Failed(s) => failed.push((i, s)),
@@ -139,12 +139,7 @@ impl FailedRun {
             .iter()
             .map(|(k, v)| format!("{k}={v}"))
             .collect();
-        let mut s = format!(
-            "{} [{}]: {}",
-            self.run.id,
-            sets.join(" "),
-            self.status
-        );
+        let mut s = format!("{} [{}]: {}", self.run.id, sets.join(" "), self.status);
         for l in &self.error_tail {
             s += &format!("\n    {l}");
         }

@@ -208,7 +208,9 @@ fn values(section: &str, key: &str, v: &toml::Value) -> Result<Vec<String>, Stri
         scalar => vec![scalar],
     };
     if list.is_empty() {
-        return Err(format!("field `{section}.{key}`: an empty list gives no runs"));
+        return Err(format!(
+            "field `{section}.{key}`: an empty list gives no runs"
+        ));
     }
     list.into_iter()
         .enumerate()
@@ -337,8 +339,7 @@ impl Manifest {
         ] {
             if let Some(v) = v {
                 let ok = !v.is_empty()
-                    && v
-                        .chars()
+                    && v.chars()
                         .all(|c| c.is_ascii_alphanumeric() || ":-_.,".contains(c));
                 if !ok {
                     return Err(err(format!(

@@ -48,7 +48,8 @@ pub struct Sweep {
 }
 
 fn atomic_text(path: &Path, text: &str) -> Result<(), SweepError> {
-    write_atomic(path, |w| w.write_all(text.as_bytes())).map_err(|e| SweepError::Other(e.to_string()))
+    write_atomic(path, |w| w.write_all(text.as_bytes()))
+        .map_err(|e| SweepError::Other(e.to_string()))
 }
 
 impl Sweep {
@@ -76,7 +77,10 @@ impl Sweep {
         match std::fs::read_to_string(dir.join(STATUS)) {
             Ok(text) => {
                 let v: serde_json::Value = serde_json::from_str(&text).unwrap_or_default();
-                let status = v["status"].as_str().unwrap_or("unreadable status").to_string();
+                let status = v["status"]
+                    .as_str()
+                    .unwrap_or("unreadable status")
+                    .to_string();
                 RunState::Failed(status)
             }
             Err(_) => RunState::Missing,
