@@ -133,7 +133,7 @@ impl FengFabric {
         }
     }
 
-    /// The measured bending curve along `d`: [`CURVE_POINTS`] points from 0 to
+    /// The measured bending curve along `d`: 21 points from 0 to
     /// [`Self::kappa_max`].
     pub fn curve(&self, d: usize) -> Curve {
         let km = self.kappa_max(d);

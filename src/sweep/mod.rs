@@ -1,7 +1,7 @@
 //! Sweeps: many independent `emilion run` processes described by one manifest (TOML), each
 //! with its own `--set` values and its own folder `out/<sweep>/<id>/`, run on this machine
 //! ([`local`]) or as a Slurm job array ([`slurm`]), and collected into one table
-//! ([`collect`]). The manifest ([`manifest`]) expands into runs with stable ids ([`expand`]);
+//! ([`mod@collect`]). The manifest ([`manifest`]) expands into runs with stable ids ([`mod@expand`]);
 //! a run's folder records its parameters, logs, exit status and a `done` marker written last
 //! ([`run_dir`]), so a restarted sweep runs only what is missing.
 //!
