@@ -317,3 +317,131 @@ fn the_slurm_script_has_one_task_per_pending_run() {
         "{args:?}"
     );
 }
+
+/// A run that takes about a second: `spin` loop steps, then one key=value line.
+const SPIN_SCRIPT: &str = r#"
+let n = if is_def_var("n") { n } else { 1 };
+let spin = if is_def_var("spin") { spin } else { 1000 };
+print(`started n=${n}`);
+let s = 0;
+for k in 0..spin { s += k % 7; }
+print(`n=${n} sum=${n * (n + 1) / 2} spin=${s}`);
+"#;
+
+/// Loop steps of a spin run: about a second here (a loaded 2-core machine).
+const SPIN_STEPS: i64 = 3_000_000;
+
+/// The processes whose working folder lies under `dir` (the runs of a sweep there).
+#[cfg(target_os = "linux")]
+fn processes_in(dir: &Path) -> Vec<u32> {
+    let mut pids = Vec::new();
+    for e in std::fs::read_dir("/proc").unwrap().flatten() {
+        let Ok(pid) = e.file_name().to_string_lossy().parse::<u32>() else {
+            continue;
+        };
+        if let Ok(cwd) = std::fs::read_link(e.path().join("cwd")) {
+            if cwd.starts_with(dir) {
+                pids.push(pid);
+            }
+        }
+    }
+    pids
+}
+
+/// Polls `f` every 10 ms for at most `seconds`; whether it became true.
+fn wait_for(seconds: f64, mut f: impl FnMut() -> bool) -> bool {
+    let start = std::time::Instant::now();
+    while start.elapsed().as_secs_f64() < seconds {
+        if f() {
+            return true;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    f()
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn a_killed_sweep_leaves_no_orphans_and_its_restart_runs_only_the_missing_runs() {
+    use std::process::{Command, Stdio};
+    let d = temp_dir("killed");
+    std::fs::write(d.join("spin.rhai"), SPIN_SCRIPT).unwrap();
+    let p = d.join("killed.toml");
+    std::fs::write(
+        &p,
+        format!(
+            "script = \"spin.rhai\"\nout = \"{}\"\n[params]\nn = [1, 2, 3, 4, 5, 6]\nspin = {SPIN_STEPS}\n",
+            d.join("out").display()
+        ),
+    )
+    .unwrap();
+    let s = Sweep::load(&p, None).unwrap();
+    let sweep_dir = s.manifest.sweep_dir();
+    let exe = env!("CARGO_BIN_EXE_emilion");
+    let mut child = Command::new(exe)
+        .args(["sweep", "run", p.to_str().unwrap(), "--local", "-j", "2"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let done = |s: &Sweep| {
+        s.runs
+            .iter()
+            .filter(|r| s.state(r) == sweep::RunState::Done)
+            .count()
+    };
+    // kill it (SIGKILL) while runs are going, after at least one is complete
+    let mut running = Vec::new();
+    assert!(
+        wait_for(120.0, || {
+            running = processes_in(&sweep_dir);
+            done(&s) >= 1 && !running.is_empty()
+        }),
+        "no run completed"
+    );
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let done_before = done(&s);
+    assert!(done_before < s.runs.len(), "every run ended before the kill");
+    // its children die with it: no orphan goes on writing into its run's folder
+    assert!(
+        wait_for(1.0, || processes_in(&sweep_dir).is_empty()),
+        "orphans {:?} (running at the kill: {running:?})",
+        processes_in(&sweep_dir)
+    );
+    let logs = |s: &Sweep| -> Vec<Option<String>> {
+        s.runs
+            .iter()
+            .map(|r| std::fs::read_to_string(s.run_dir(r).join("status.json")).ok())
+            .collect()
+    };
+    let status_before = logs(&s);
+    // restarted: only the missing runs start
+    let again = Command::new(exe)
+        .args(["sweep", "run", p.to_str().unwrap(), "--local", "-j", "2"])
+        .output()
+        .unwrap();
+    assert!(again.status.success(), "{again:?}");
+    let line = String::from_utf8_lossy(&again.stdout).to_string();
+    let missing = s.runs.len() - done_before;
+    assert!(
+        line.contains(&format!("runs=6 ran={missing} skipped_complete={done_before} done=6 failed=0")),
+        "{line}"
+    );
+    for (r, (before, after)) in s.runs.iter().zip(status_before.iter().zip(logs(&s))) {
+        // a run complete before the kill was not run again: its exit record is the same file
+        if before.is_some() {
+            assert_eq!(before.as_ref(), after.as_ref(), "{}", r.id);
+        }
+        let out = std::fs::read_to_string(s.run_dir(r).join("stdout.log")).unwrap();
+        assert_eq!(out.matches("started").count(), 1, "{}: {out}", r.id);
+    }
+    assert_eq!(status_before.iter().flatten().count(), done_before);
+    // the collected table is an uninterrupted sweep's
+    let whole = Sweep::load(&p, Some(&d.join("whole"))).unwrap();
+    assert_eq!(local(&whole, 2, false).done, 6);
+    let t = std::fs::read_to_string(sweep::collect(&s).unwrap().csv).unwrap();
+    let t_whole = std::fs::read_to_string(sweep::collect(&whole).unwrap().csv).unwrap();
+    assert_eq!(t, t_whole);
+    check_sums(&t);
+}

@@ -151,7 +151,9 @@ impl Sweep {
         };
         let (out, err) = (open(STDOUT)?, open(STDERR)?);
         let start = Instant::now();
-        let status = Command::new(exe)
+        let mut cmd = Command::new(exe);
+        die_with_parent(&mut cmd);
+        let status = cmd
             .args(self.run_args(run, &dir))
             .current_dir(&dir)
             .env(
@@ -183,6 +185,33 @@ impl Sweep {
         }
     }
 }
+
+/// Makes the child die (SIGKILL) when the thread that started it dies, so a killed sweep
+/// leaves no orphan runs writing into their folders: on Linux, `PR_SET_PDEATHSIG` set between
+/// fork and exec (and the child exits at once if the sweep died before that). The thread that
+/// starts a run waits for it, so it lives as long as the run. Elsewhere a no-op.
+#[cfg(target_os = "linux")]
+fn die_with_parent(cmd: &mut Command) {
+    use std::os::unix::process::CommandExt;
+    let parent = std::process::id() as libc::pid_t;
+    // SAFETY: the closure runs in the forked child before exec and calls only the
+    // async-signal-safe `prctl`, `getppid` and `_exit`, allocating nothing.
+    unsafe {
+        cmd.pre_exec(move || {
+            if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL, 0, 0, 0) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            if libc::getppid() != parent {
+                libc::_exit(137);
+            }
+            Ok(())
+        });
+    }
+}
+
+/// Elsewhere the children outlive a killed sweep (no parent-death signal).
+#[cfg(not(target_os = "linux"))]
+fn die_with_parent(_cmd: &mut Command) {}
 
 /// The last `n` non-empty lines of a text file (empty when it cannot be read), read within
 /// the `max_file_bytes` limit.
