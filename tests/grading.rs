@@ -1,7 +1,7 @@
 //! Grading (docs/sweeps.md): a pattern and the mannequin scaled to another size, checked
 //! against the linear map's exact effect — corners and placements scaled, polygon areas by
 //! girth × height, the mannequin's height, width and enclosed volume (girth² × height), feet
-//! left on the floor — and bad factors named.
+//! left on the floor, every bone end's height — and bad factors named.
 
 use std::path::PathBuf;
 
@@ -27,7 +27,10 @@ fn corner_area(c: &[[f64; 2]]) -> f64 {
 fn a_graded_pattern_is_the_pattern_scaled_across_and_along() {
     let p = read_garment(root().join("scripts/patterns/aaron.garment.json")).unwrap();
     let g = p.graded(1.06, 1.06).unwrap();
-    assert_eq!((g.pieces.len(), g.seams.len()), (p.pieces.len(), p.seams.len()));
+    assert_eq!(
+        (g.pieces.len(), g.seams.len()),
+        (p.pieces.len(), p.seams.len())
+    );
     for (a, b) in p.pieces.iter().zip(&g.pieces) {
         let ca: Vec<[f64; 2]> = a.outline.corners.iter().map(|c| c.at).collect();
         let cb: Vec<[f64; 2]> = b.outline.corners.iter().map(|c| c.at).collect();
@@ -71,11 +74,17 @@ fn a_graded_mannequin_is_the_mannequin_scaled_with_its_feet_on_the_floor() {
     assert!((extent(&g, 0).1 - girth * extent(&m, 0).1).abs() < 1e-12);
     let v0 = signed_volume(m.rest_positions(), m.triangles());
     let v1 = signed_volume(g.rest_positions(), g.triangles());
-    assert!((v1 / v0 - girth * girth * height).abs() < 1e-9, "{}", v1 / v0);
-    // the skeleton moves with the skin
-    let hip = |m: &Mannequin| m.skeleton().joint("pelvis").map(|j| j.rest[2]);
-    if let (Some(a), Some(b)) = (hip(&m), hip(&g)) {
-        assert!((b - height * a).abs() < 1e-12);
+    assert!(
+        (v1 / v0 - girth * girth * height).abs() < 1e-9,
+        "{}",
+        v1 / v0
+    );
+    // the skeleton moves with the skin: heights × height, from the floor
+    let (b0, b1) = (m.skeleton().bones(), g.skeleton().bones());
+    assert_eq!(b0.len(), b1.len());
+    for (a, b) in b0.iter().zip(b1) {
+        assert!((b.head.z - height * a.head.z).abs() < 1e-12, "{}", a.name);
+        assert!((b.tail.z - height * a.tail.z).abs() < 1e-12, "{}", a.name);
     }
     let e = m.graded(0.1, 1.0).unwrap_err().to_string();
     assert!(e.contains("girth") && e.contains("0.5 to 2"), "{e}");

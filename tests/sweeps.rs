@@ -157,6 +157,10 @@ fn bad_manifests_name_the_file_and_the_field() {
 fn check_sums(csv: &str) {
     let mut lines = csv.lines();
     let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    // every column once: a printed key that is also a parameter is not repeated
+    for (i, h) in head.iter().enumerate() {
+        assert!(!head[..i].contains(h), "column {h} twice in {head:?}");
+    }
     let col = |name: &str| head.iter().position(|h| *h == name).unwrap();
     let (n, sum, status) = (col("n"), col("sum"), col("status"));
     for l in lines {
@@ -402,7 +406,10 @@ fn a_killed_sweep_leaves_no_orphans_and_its_restart_runs_only_the_missing_runs()
     child.kill().unwrap();
     child.wait().unwrap();
     let done_before = done(&s);
-    assert!(done_before < s.runs.len(), "every run ended before the kill");
+    assert!(
+        done_before < s.runs.len(),
+        "every run ended before the kill"
+    );
     // its children die with it: no orphan goes on writing into its run's folder
     assert!(
         wait_for(1.0, || processes_in(&sweep_dir).is_empty()),
@@ -425,7 +432,9 @@ fn a_killed_sweep_leaves_no_orphans_and_its_restart_runs_only_the_missing_runs()
     let line = String::from_utf8_lossy(&again.stdout).to_string();
     let missing = s.runs.len() - done_before;
     assert!(
-        line.contains(&format!("runs=6 ran={missing} skipped_complete={done_before} done=6 failed=0")),
+        line.contains(&format!(
+            "runs=6 ran={missing} skipped_complete={done_before} done=6 failed=0"
+        )),
         "{line}"
     );
     for (r, (before, after)) in s.runs.iter().zip(status_before.iter().zip(logs(&s))) {

@@ -130,7 +130,9 @@ pub fn collect(sweep: &Sweep) -> Result<Collected, SweepError> {
         };
         rows.push(Row { status, values });
     }
+    // a printed key that is also a parameter (`seed=…`) keeps the parameter's column only
     let keys = if m.collect.keys.is_empty() {
+        found_keys.retain(|k| !param_keys.contains(k));
         found_keys
     } else {
         m.collect.keys.clone()
