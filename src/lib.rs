@@ -22,4 +22,5 @@ pub mod render;
 pub mod scenes;
 #[cfg(feature = "scripting")]
 pub mod script;
+pub mod sweep;
 pub mod tracking;

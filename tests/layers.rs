@@ -566,6 +566,8 @@ const LAYERS: &[&[&str]] = &[
     &["garment", "kes"],
     &["tracking", "face", "facade"],
     &["scenes", "bench"],
+    // sweeps start `emilion run` as child processes; they do not link the scripting layer
+    &["sweep"],
     &["script"],
     // the binary's own modules (src/cli/, used by src/main.rs)
     &["cli"],

@@ -31,6 +31,7 @@
 
 pub mod bvh;
 pub mod error;
+pub mod grading;
 pub mod markers;
 pub mod retarget;
 pub mod skeleton;
