@@ -9,7 +9,7 @@ use super::convert::{count, rt_err, RResult};
 use super::paths::{read_folder, read_path, write_folder};
 use super::{function, modules::ApiBuilder};
 use crate::facade::learned::classes::Element;
-use crate::facade::learned::evaluate::{evaluate_folder, EvalOptions, Split};
+use crate::facade::learned::evaluate::{evaluate_folder, EvalOptions, Split, DEFAULT_WINDOW_BOOST};
 use crate::facade::learned::model::{Model, MODEL_FILE};
 use crate::facade::learned::train::{train, FeatureSet, TrainOptions};
 
@@ -17,7 +17,9 @@ use crate::facade::learned::train::{train, FeatureSet, TrainOptions};
 fn bounded(v: &Dynamic, what: &str, min: usize, max: usize) -> RResult<usize> {
     let n = count(v, what)?;
     if n < min || n > max {
-        return Err(rt_err(format!("`{what}` must be in {min}..={max}, got {n}")));
+        return Err(rt_err(format!(
+            "`{what}` must be in {min}..={max}, got {n}"
+        )));
     }
     Ok(n)
 }
@@ -80,6 +82,7 @@ fn eval_options(m: &Map) -> RResult<EvalOptions> {
         split: Split::Holdout,
         structure: true,
         limit: 0,
+        window_boost: DEFAULT_WINDOW_BOOST,
     };
     for (k, v) in m {
         match k.as_str() {
@@ -96,9 +99,19 @@ fn eval_options(m: &Map) -> RResult<EvalOptions> {
                     .map_err(|_| rt_err("`structure` must be true or false"))?
             }
             "limit" => o.limit = count(v, "limit")?,
+            "window_boost" => {
+                let b = super::convert::finite(v, "window_boost")?;
+                if !(0.1..=10.0).contains(&b) {
+                    return Err(rt_err(format!(
+                        "`window_boost` must be in 0.1..=10, got {b}"
+                    )));
+                }
+                o.window_boost = b as f32;
+            }
             other => {
                 return Err(rt_err(format!(
-                    "unknown evaluation option `{other}` (known: split, structure, limit)"
+                    "unknown evaluation option `{other}` (known: split, structure, limit, \
+                     window_boost)"
                 )))
             }
         }
@@ -148,7 +161,13 @@ images, samples, feature_seconds, forest_seconds, nodes}.",
         "The folder where a trained facade model is cached by default: `out/facade_model`
 under the working directory (outside the repository's tracked files; a script may write
 there).",
-        || -> String { super::paths::working_dir().join("out").join("facade_model").display().to_string() }
+        || -> String {
+            super::paths::working_dir()
+                .join("out")
+                .join("facade_model")
+                .display()
+                .to_string()
+        }
     );
     function!(
         engine,
@@ -183,7 +202,8 @@ parse as `OUT/pred/STEM.png` in the folder's own label format and the scores as
 accuracy, per-class IoU, the all-wall and all-window baselines). Options: #{split:
 \"holdout\" (default: a CMP folder's held-out quarter, every 4th photo from the 4th; all of a
 LabelMeFacade folder) | \"all\", structure: true (windows as aligned rectangles, doors at
-street level) | false (the classifier alone), limit: N}. Returns #{layout, images, window_iou,
+street level) | false (the classifier alone), limit: N, window_boost: factor on the window
+probability (default `DEFAULT_WINDOW_BOOST`)}. Returns #{layout, images, window_iou,
 f1, pixel_accuracy, all_wall_accuracy, all_window_iou, seconds_per_megapixel, csv,
 iou_window, iou_door, …}.",
         |dir: &str, out: &str, model: &str, m: Map| -> RResult<Map> {
@@ -192,7 +212,8 @@ iou_window, iou_door, …}.",
             let out = write_folder(out)?;
             let model =
                 Model::load(&model_path(&read_path(model)?)).map_err(|e| rt_err(e.to_string()))?;
-            let s = evaluate_folder(&dir, &out, &model, &opts).map_err(|e| rt_err(e.to_string()))?;
+            let s =
+                evaluate_folder(&dir, &out, &model, &opts).map_err(|e| rt_err(e.to_string()))?;
             let mut r = Map::new();
             r.insert("layout".into(), Dynamic::from(s.layout.name().to_string()));
             r.insert("images".into(), Dynamic::from_int(s.images as INT));

@@ -60,9 +60,12 @@ fn file_err(path: &Path, message: impl Into<String>) -> FacadeError {
 /// labelled photo.
 pub fn labelled_folder(dir: &Path) -> Result<(Vec<String>, Layout), FacadeError> {
     let stems = labelled_images(dir)?;
-    let first = stems
-        .first()
-        .ok_or_else(|| file_err(dir, "no labelled photo (images/STEM.* with labels/STEM.png)"))?;
+    let first = stems.first().ok_or_else(|| {
+        file_err(
+            dir,
+            "no labelled photo (images/STEM.* with labels/STEM.png)",
+        )
+    })?;
     let layout = detect_layout(&label_path(dir, first))?;
     Ok((stems, layout))
 }

@@ -14,11 +14,14 @@ use super::super::report::labelled_photo;
 use super::super::score::{FacadeScore, PixelScore};
 use super::classes::{Element, N_CLASSES};
 use super::dataset::{
-    is_cmp_holdout, label_path, labelled_folder, read_elements, write_elements, ElementMap,
-    Layout,
+    is_cmp_holdout, label_path, labelled_folder, read_elements, write_elements, ElementMap, Layout,
 };
 use super::model::Model;
 use super::photo_parse::parse_photo;
+
+/// The default factor on the window probability (chosen on the training folders, see
+/// docs/facades.md).
+pub const DEFAULT_WINDOW_BOOST: f32 = 1.0;
 
 /// Which images of the folder are scored.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -39,6 +42,8 @@ pub struct EvalOptions {
     pub structure: bool,
     /// At most this many images (0: all).
     pub limit: usize,
+    /// Factor on the window probability ([`parse_photo`]).
+    pub window_boost: f32,
 }
 
 /// Figures over the folder.
@@ -147,7 +152,7 @@ pub fn evaluate_folder(
                 what: format!("{} and its label map differ in size", photo.display()),
             });
         }
-        let mut parse = parse_photo(model, &rgb, opts.structure);
+        let mut parse = parse_photo(model, &rgb, opts.structure, opts.window_boost);
         for c in parse.elements.classes.iter_mut() {
             *c = as_written(*c, layout);
         }

@@ -4,7 +4,10 @@
 //! normalised position, row and column projections (Müller's floors and tiles show as bands
 //! of horizontal and vertical edges), and repetition: the floor and tile periods found by
 //! autocorrelation of those projections, and what the pixel's darkness and look are one
-//! period up, down, left and right (a window repeats; a shadow or a tree seldom does).
+//! period up, down, left and right (a window repeats; a shadow or a tree seldom does); and
+//! context: how much lighter the surroundings are at eight directions and three distances
+//! (the offset comparisons of Shotton et al.'s TextonBoost forests: a window is darker than
+//! the wall a half-window away on every side).
 
 use image::RgbImage;
 
@@ -14,15 +17,75 @@ use crate::geometry::image::Gray;
 /// Longer side of the working image, pixels.
 pub const WORK_SIDE: u32 = 320;
 
+/// Offsets (pixels at the working resolution) at which the look of the surroundings is
+/// compared with the pixel's: eight directions at each of these radii.
+pub const OFFSET_RADII: [f32; 3] = [4.0, 10.0, 20.0];
+
+/// Features before the offset comparisons.
+pub const N_BASE_FEATURES: usize = 33;
+
 /// Number of features per pixel.
-pub const N_FEATURES: usize = 33;
+pub const N_FEATURES: usize = N_BASE_FEATURES + 8 * OFFSET_RADII.len();
 
 /// The features' names, in order.
 pub const FEATURE_NAMES: [&str; N_FEATURES] = [
-    "L", "a", "b", "L_s3", "a_s3", "b_s3", "L_s10", "a_s10", "b_s10", "dark_s10", "dark_s3_s10",
-    "grad_s1", "gx_s3", "gy_s3", "grad_s8", "std_s3", "Lxx_s2", "Lyy_s2", "x", "y", "row_L",
-    "col_L", "row_gy", "col_gx", "row_dark", "col_dark", "rep_dark_y", "rep_dark_x", "rep_diff_y",
-    "rep_diff_x", "floor_period", "tile_period", "L_rel",
+    "L",
+    "a",
+    "b",
+    "L_s3",
+    "a_s3",
+    "b_s3",
+    "L_s10",
+    "a_s10",
+    "b_s10",
+    "dark_s10",
+    "dark_s3_s10",
+    "grad_s1",
+    "gx_s3",
+    "gy_s3",
+    "grad_s8",
+    "std_s3",
+    "Lxx_s2",
+    "Lyy_s2",
+    "x",
+    "y",
+    "row_L",
+    "col_L",
+    "row_gy",
+    "col_gx",
+    "row_dark",
+    "col_dark",
+    "rep_dark_y",
+    "rep_dark_x",
+    "rep_diff_y",
+    "rep_diff_x",
+    "floor_period",
+    "tile_period",
+    "L_rel",
+    "off4_e",
+    "off4_ne",
+    "off4_n",
+    "off4_nw",
+    "off4_w",
+    "off4_sw",
+    "off4_s",
+    "off4_se",
+    "off10_e",
+    "off10_ne",
+    "off10_n",
+    "off10_nw",
+    "off10_w",
+    "off10_sw",
+    "off10_s",
+    "off10_se",
+    "off20_e",
+    "off20_ne",
+    "off20_n",
+    "off20_nw",
+    "off20_w",
+    "off20_sw",
+    "off20_s",
+    "off20_se",
 ];
 
 /// Indices of the features that describe the pixel and its neighbourhood alone (colour and
@@ -99,8 +162,8 @@ fn gray(w: u32, h: u32, data: Vec<f32>) -> Gray<f32> {
     }
 }
 
-/// The period of a profile: the smallest lag in `[n/16, n/2]` whose normalised
-/// autocorrelation is within 85 % of the largest there; 0 when that is below 0.1 (no
+/// The period of a profile (detrended by a moving mean of `n/8`): the smallest lag in
+/// `[n/16, n/2]` whose normalised autocorrelation is within 85 % of the largest there; 0 when that is below 0.1 (no
 /// repetition).
 pub fn profile_period(p: &[f32]) -> usize {
     let n = p.len();
@@ -108,8 +171,14 @@ pub fn profile_period(p: &[f32]) -> usize {
     if hi <= lo {
         return 0;
     }
-    let mean = p.iter().sum::<f32>() / n as f32;
-    let d: Vec<f32> = p.iter().map(|v| v - mean).collect();
+    // detrended: minus a moving mean over n/8 (sky above, street below are no period)
+    let r = (n / 16).max(1);
+    let d: Vec<f32> = (0..n)
+        .map(|i| {
+            let (a, b) = (i.saturating_sub(r), (i + r + 1).min(n));
+            p[i] - p[a..b].iter().sum::<f32>() / (b - a) as f32
+        })
+        .collect();
     let var: f32 = d.iter().map(|v| v * v).sum::<f32>() / n as f32;
     if var <= 1e-12 {
         return 0;
@@ -237,14 +306,22 @@ pub fn pixel_features(img: &RgbImage) -> PixelFeatures {
             f[23] = col_gx[x] / mean_g;
             f[24] = row_dark[y];
             f[25] = col_dark[x];
+            let own3 = s3[0][i];
             f[26] = periodic_mean(y, ty, hu, |k| dark[k * wu + x], dark[i]);
             f[27] = periodic_mean(x, tx, wu, |k| dark[y * wu + k], dark[i]);
-            let own3 = s3[0][i];
             f[28] = periodic_mean(y, ty, hu, |k| (s3[0][k * wu + x] - own3).abs(), 0.0);
             f[29] = periodic_mean(x, tx, wu, |k| (s3[0][y * wu + k] - own3).abs(), 0.0);
             f[30] = ty as f32 / h as f32;
             f[31] = tx as f32 / w as f32;
             f[32] = l[i] - mean_l;
+            for (k, r) in OFFSET_RADII.iter().enumerate() {
+                for d in 0..8 {
+                    let a = d as f32 * std::f32::consts::FRAC_PI_4;
+                    let ox = (x as f32 + r * a.cos()).round().clamp(0.0, (wu - 1) as f32);
+                    let oy = (y as f32 - r * a.sin()).round().clamp(0.0, (hu - 1) as f32);
+                    f[N_BASE_FEATURES + 8 * k + d] = s3[0][oy as usize * wu + ox as usize] - own3;
+                }
+            }
         }
     }
     PixelFeatures {
@@ -266,12 +343,17 @@ mod tests {
         // sRGB red: L 53.24, a 80.09, b 67.20 (CIE Lab, D65)
         let r = lab([255, 0, 0]);
         assert!((r[0] - 53.24).abs() < 0.1, "{r:?}");
-        assert!((r[1] - 80.09).abs() < 0.3 && (r[2] - 67.20).abs() < 0.3, "{r:?}");
+        assert!(
+            (r[1] - 80.09).abs() < 0.3 && (r[2] - 67.20).abs() < 0.3,
+            "{r:?}"
+        );
     }
 
     #[test]
     fn the_period_of_a_comb_is_its_spacing() {
-        let p: Vec<f32> = (0..200).map(|i| if i % 37 < 4 { 1.0 } else { 0.0 }).collect();
+        let p: Vec<f32> = (0..200)
+            .map(|i| if i % 37 < 4 { 1.0 } else { 0.0 })
+            .collect();
         assert_eq!(profile_period(&p), 37);
         assert_eq!(profile_period(&[0.5; 100]), 0);
     }

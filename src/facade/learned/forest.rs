@@ -31,7 +31,13 @@ impl Quantizer {
                 let mut v: Vec<f32> = (0..n).map(|i| rows[i * n_features + f]).collect();
                 v.sort_by(|a, b| a.total_cmp(b));
                 (1..N_BINS)
-                    .map(|k| if n == 0 { 0.0 } else { v[(k * n / N_BINS).min(n - 1)] })
+                    .map(|k| {
+                        if n == 0 {
+                            0.0
+                        } else {
+                            v[(k * n / N_BINS).min(n - 1)]
+                        }
+                    })
                     .collect()
             })
             .collect();
@@ -179,7 +185,9 @@ fn grow_tree(bins: &[u8], nf: usize, labels: &[u8], p: &ForestParams, t: u64) ->
         let split = if pure || depth >= p.max_depth || part.len() < 2 * p.min_leaf {
             None
         } else {
-            best_split(bins, nf, labels, part, &counts, p, &mut feats, &mut rng, &mut hist)
+            best_split(
+                bins, nf, labels, part, &counts, p, &mut feats, &mut rng, &mut hist,
+            )
         };
         match split {
             None => {
@@ -288,7 +296,11 @@ mod tests {
         let mut rows = Vec::new();
         let mut labels = Vec::new();
         for _ in 0..n {
-            let (a, b, c) = (rng.uniform() as f32, rng.uniform() as f32, rng.uniform() as f32);
+            let (a, b, c) = (
+                rng.uniform() as f32,
+                rng.uniform() as f32,
+                rng.uniform() as f32,
+            );
             rows.extend([a, b, c]);
             labels.push(((a > 0.5) ^ (b > 0.5)) as u8);
         }
@@ -309,7 +321,10 @@ mod tests {
         let forest = Forest::grow(&bins, 3, &labels, &p);
         let mut right = 0;
         let mut out = [0.0; N_CLASSES];
-        for (k, (a, b)) in [(0.2, 0.2), (0.2, 0.8), (0.8, 0.2), (0.8, 0.8)].iter().enumerate() {
+        for (k, (a, b)) in [(0.2, 0.2), (0.2, 0.8), (0.8, 0.2), (0.8, 0.8)]
+            .iter()
+            .enumerate()
+        {
             let mut bb = [0u8; 3];
             q.bins(&[*a, *b, 0.5], &mut bb);
             forest.predict(&bb, &mut out);

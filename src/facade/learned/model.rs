@@ -14,7 +14,7 @@ use super::forest::{Forest, Node, Quantizer, Tree, N_BINS};
 pub const MAGIC: &[u8; 16] = b"EMILION-FACADE\x00\x01";
 
 /// Version of the file layout; bumped whenever the layout, the features or the classes change.
-pub const MODEL_VERSION: u32 = 1;
+pub const MODEL_VERSION: u32 = 2;
 
 /// File name of the model inside its folder.
 pub const MODEL_FILE: &str = "facade_forest.bin";
@@ -167,7 +167,12 @@ fn parse(b: &[u8]) -> Result<Model, String> {
         ));
     }
     let dims = [r.u32()?, r.u32()?, r.u32()?, r.u32()?];
-    let want = [N_FEATURES as u32, N_CLASSES as u32, N_BINS as u32, WORK_SIDE];
+    let want = [
+        N_FEATURES as u32,
+        N_CLASSES as u32,
+        N_BINS as u32,
+        WORK_SIDE,
+    ];
     if dims != want {
         return Err(format!(
             "facade model for (features, classes, bins, working side) {dims:?}, this emilion \
@@ -187,7 +192,11 @@ fn parse(b: &[u8]) -> Result<Model, String> {
     }
     let mut edges = Vec::with_capacity(N_FEATURES);
     for _ in 0..N_FEATURES {
-        edges.push((0..N_BINS - 1).map(|_| r.f32()).collect::<Result<Vec<_>, _>>()?);
+        edges.push(
+            (0..N_BINS - 1)
+                .map(|_| r.f32())
+                .collect::<Result<Vec<_>, _>>()?,
+        );
     }
     let nt = r.count("tree", 8)?;
     let mut trees = Vec::with_capacity(nt);

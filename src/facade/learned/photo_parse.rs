@@ -30,12 +30,22 @@ pub struct LearnedParse {
 
 /// Parses `rgb` with `model`; `structure` applies the corrections (windows as aligned
 /// rectangles, doors at street level), otherwise windows are the bounding boxes of the
-/// classifier's window pieces and the classes its argmax.
-pub fn parse_photo(model: &Model, rgb: &RgbImage, structure: bool) -> LearnedParse {
+/// classifier's window pieces and the classes its argmax. The window probability is
+/// multiplied by `window_boost` before either (a prior shift: the forest, trained on pixels
+/// drawn evenly, under-calls the minority class).
+pub fn parse_photo(
+    model: &Model,
+    rgb: &RgbImage,
+    structure: bool,
+    window_boost: f32,
+) -> LearnedParse {
     let t0 = Instant::now();
     let work = working_image(rgb);
     let feats = pixel_features(&work);
-    let probs = model.probabilities(&feats);
+    let mut probs = model.probabilities(&feats);
+    for p in probs.chunks_exact_mut(N_CLASSES) {
+        p[Element::Window.index()] *= window_boost;
+    }
     let (w, h) = (feats.width as usize, feats.height as usize);
     let (classes, rects) = if structure {
         let rects = window_rectangles(&probs, w, h);

@@ -112,7 +112,11 @@ pub fn training_images(
             .map(|(_, s)| s)
             .collect();
         let n = kept.len();
-        let take = if max_images == 0 { n } else { max_images.min(n) };
+        let take = if max_images == 0 {
+            n
+        } else {
+            max_images.min(n)
+        };
         for j in 0..take {
             let s = kept[j * n / take.max(1)];
             out.push((labelled_photo(dir, s)?, label_path(dir, s), layout));
