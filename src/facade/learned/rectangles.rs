@@ -56,16 +56,22 @@ fn bands(iv: &[(u32, u32)]) -> Vec<Vec<usize>> {
     groups
 }
 
-fn median(mut v: Vec<u32>) -> u32 {
+/// The two middle values of `v` (the same one for an odd count).
+fn middle_pair(mut v: Vec<u32>) -> (u32, u32) {
     v.sort_unstable();
-    v[v.len() / 2]
+    let n = v.len();
+    (v[(n - 1) / 2], v[n / 2])
 }
 
+/// A band's median sides: for an odd count the median of the starts and of the ends; for an
+/// even count, where the two middle values tie (a floor of two windows, one a row short),
+/// the wider of them on each side (the lower middle start, the upper middle end), so a
+/// window that lost a row at its side to the classifier is restored rather than the other
+/// one cut (the middle windows' union, as a band holds the pixels of all its windows).
 fn median_band(g: &[usize], iv: &[(u32, u32)]) -> (u32, u32) {
-    (
-        median(g.iter().map(|&i| iv[i].0).collect()),
-        median(g.iter().map(|&i| iv[i].1).collect()),
-    )
+    let (lo, _) = middle_pair(g.iter().map(|&i| iv[i].0).collect());
+    let (_, hi) = middle_pair(g.iter().map(|&i| iv[i].1).collect());
+    (lo, hi)
 }
 
 /// Moves each interval's ends to its band's median ends when they are within `tol` of its
@@ -182,11 +188,10 @@ pub fn corrected_classes(probs: &[f32], w: usize, h: usize, windows: &[Rect]) ->
 mod tests {
     use super::*;
 
-    /// Probabilities of a 60 × 40 picture: windows of 6 × 8 px on two floors and three
-    /// columns, one of them missing from the argmax but likely (0.45) there, one of the top
-    /// floor starting a row low (the median of its floor of three snaps it back).
-    #[test]
-    fn a_missing_window_of_a_lattice_is_filled_and_ragged_sides_are_aligned() {
+    /// Probabilities of a 60 × 40 picture: windows of 6 × 8 px on two floors (tops at rows
+    /// 5 and 25) and three columns, the one at (25, 50) missing from the argmax but likely
+    /// (0.45) there, and the windows at `ragged` (floor top, column left) starting a row low.
+    fn lattice(ragged: &[(usize, usize)]) -> Vec<f32> {
         let (w, h) = (60, 40);
         let mut probs = vec![0f32; w * h * N_CLASSES];
         for i in 0..w * h {
@@ -194,8 +199,8 @@ mod tests {
             probs[i * N_CLASSES] = 0.2;
         }
         for (fy, cx) in [(5, 10), (5, 30), (5, 50), (25, 10), (25, 30), (25, 50)] {
-            let ragged = if (fy, cx) == (5, 30) { 1 } else { 0 };
-            for y in fy + ragged..fy + 8 {
+            let low = usize::from(ragged.contains(&(fy, cx)));
+            for y in fy + low..fy + 8 {
                 for x in cx..cx + 6 {
                     let p = &mut probs[(y * w + x) * N_CLASSES..][..N_CLASSES];
                     if (fy, cx) == (25, 50) {
@@ -208,14 +213,36 @@ mod tests {
                 }
             }
         }
-        let mut r = window_rectangles(&probs, w, h);
+        probs
+    }
+
+    /// The six windows of [`lattice`], each 6 × 8 px at its place, and the filled one's
+    /// pixels window in the corrected classes.
+    fn assert_full_lattice(probs: &[f32]) {
+        let (w, h) = (60, 40);
+        let mut r = window_rectangles(probs, w, h);
         r.sort_by_key(|r| (r.y0, r.x0));
         assert_eq!(r.len(), 6, "{r:?}");
-        for q in &r {
-            assert_eq!((q.y1 - q.y0, q.x1 - q.x0), (8, 6), "{q:?}");
+        let places = [(5, 10), (5, 30), (5, 50), (25, 10), (25, 30), (25, 50)];
+        for (q, (fy, cx)) in r.iter().zip(places) {
+            assert_eq!((q.y0, q.x0, q.y1, q.x1), (fy, cx, fy + 8, cx + 6), "{r:?}");
         }
-        let c = corrected_classes(&probs, w, h, &r);
+        let c = corrected_classes(probs, w, h, &r);
         assert_eq!(c[27 * w + 52], Element::Window);
         assert_eq!(c[0], Element::Wall);
+    }
+
+    /// The ragged window stands in a floor of three (its median is the other two's side).
+    #[test]
+    fn a_missing_window_of_a_lattice_is_filled_and_ragged_sides_are_aligned() {
+        assert_full_lattice(&lattice(&[(5, 30)]));
+    }
+
+    /// Regression: in a floor of two windows (the third missing from the argmax) the median
+    /// of an even count took the upper middle value, so a window one row low cut its
+    /// neighbour by a row instead of being snapped back; both ragged middle windows here.
+    #[test]
+    fn a_window_one_row_low_in_a_floor_of_two_is_snapped_back() {
+        assert_full_lattice(&lattice(&[(5, 30), (25, 30)]));
     }
 }
