@@ -166,6 +166,7 @@ fn the_training_and_evaluation_scripts_run_on_a_few_photos() {
         .arg(root.join("scripts/facades_eval.rhai"))
         .args(["--set", &format!("dir={}", cmp.display())])
         .args(["--set", &format!("out={}", out.display())])
+        .args(["--set", "method=learned"])
         .args(["--set", &format!("model={}", model.display())])
         .args(["--set", "limit=1"])
         .output()
