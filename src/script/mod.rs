@@ -15,6 +15,7 @@
 //! - [`output`]: positions, bounds, energies, OBJ/glTF/CSV/JSON/PNG output;
 //! - [`kes`]: the virtual Kawabata lab (fabric files, rigs, fitting, summaries);
 //! - [`facade`], [`facade_analysis`]: facade label maps, scores and the photo pipeline;
+//! - [`facade_learned`]: the learned facade classifier (training, evaluation);
 //! - [`tracking_sequence`], [`tracking`]: synthetic multi-camera sequences and the body tracker;
 //! - [`paths`]: where a script's relative paths lead (its own folder), `script_dir()`,
 //!   `data_dir()`, `out_dir()`; [`sandbox`]: what a script may read and write; [`imports`]:
@@ -31,6 +32,7 @@ pub mod docs;
 pub mod fabric;
 pub mod facade;
 pub mod facade_analysis;
+pub mod facade_learned;
 pub mod face;
 pub mod garment;
 pub mod golf;
@@ -181,6 +183,7 @@ pub fn build_engine_with(limits: EngineLimits) -> Engine {
     measure::register(&mut engine);
     facade::register(&mut engine);
     facade_analysis::register(&mut engine);
+    facade_learned::register(&mut engine);
     tracking::register(&mut engine);
     golf::register(&mut engine);
     face::register(&mut engine);
