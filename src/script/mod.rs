@@ -43,6 +43,7 @@ pub mod repl;
 pub mod run;
 pub mod sandbox;
 pub mod sim;
+pub mod shell;
 pub mod sim_run;
 pub mod tracking;
 pub mod tracking_sequence;
@@ -184,6 +185,7 @@ pub fn build_engine_with(limits: EngineLimits) -> Engine {
     face::register(&mut engine);
     tracking_sequence::register(&mut engine);
     kes::register(&mut engine);
+    shell::register(&mut engine);
     paths::register(&mut engine);
     engine.finish()
 }
