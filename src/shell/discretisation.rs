@@ -70,6 +70,80 @@ fn resolve(d: Direction, normal: &V3) -> V3 {
     }
 }
 
+/// Distance from `x` along the unit direction `dir` to where the ray leaves the rectangle
+/// `dom`, capped at `r`.
+fn ray_reach(x: [f64; 2], dir: [f64; 2], r: f64, dom: [f64; 4]) -> f64 {
+    let mut t = r;
+    for k in 0..2 {
+        if dir[k] > 1e-15 {
+            t = t.min((dom[2 * k + 1] - x[k]) / dir[k]);
+        } else if dir[k] < -1e-15 {
+            t = t.min((dom[2 * k] - x[k]) / dir[k]);
+        }
+    }
+    t.max(0.0)
+}
+
+/// Angles and weights of the angular quadrature of a circle of radius `r` about `x` clipped by
+/// the rectangle `dom`: the breaks are where the circle crosses an edge line and the corners'
+/// directions; a whole circle gets `n` equally spaced angles (exact for its trigonometric
+/// integrands), each arc between breaks Gauss points (`gp`, `gw`) repeated over pieces of at
+/// most 2π/n·gauss.
+fn arc_quadrature(x: [f64; 2], r: f64, dom: [f64; 4], n: usize, gp: &[f64], gw: &[f64]) -> Vec<(f64, f64)> {
+    use std::f64::consts::PI;
+    let mut breaks = Vec::new();
+    for k in 0..2 {
+        for side in 0..2 {
+            let d = dom[2 * k + side] - x[k];
+            if d.abs() < r {
+                let c = (d / r).clamp(-1.0, 1.0);
+                let s = (1.0 - c * c).sqrt();
+                // points x + r (cos θ, sin θ) with the k-th coordinate offset d
+                let pts = if k == 0 { [[c, s], [c, -s]] } else { [[s, c], [-s, c]] };
+                for p in pts {
+                    breaks.push(p[1].atan2(p[0]));
+                }
+            }
+        }
+    }
+    for cx in [dom[0], dom[1]] {
+        for cy in [dom[2], dom[3]] {
+            let (dx, dy) = (cx - x[0], cy - x[1]);
+            if dx * dx + dy * dy < r * r && (dx != 0.0 || dy != 0.0) {
+                breaks.push(dy.atan2(dx));
+            }
+        }
+    }
+    if breaks.is_empty() {
+        return (0..n).map(|i| (2.0 * PI * i as f64 / n as f64, 2.0 * PI / n as f64)).collect();
+    }
+    for b in &mut breaks {
+        if *b < 0.0 {
+            *b += 2.0 * PI;
+        }
+    }
+    breaks.sort_by(f64::total_cmp);
+    breaks.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+    let first = breaks[0];
+    breaks.push(first + 2.0 * PI);
+    let piece = 2.0 * PI / n as f64 * gp.len() as f64;
+    let mut out = Vec::new();
+    for w in breaks.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if b - a < 1e-14 {
+            continue;
+        }
+        let pieces = ((b - a) / piece).ceil().max(1.0) as usize;
+        let h = (b - a) / pieces as f64;
+        for m in 0..pieces {
+            for (g, wg) in gp.iter().zip(gw) {
+                out.push((a + h * (m as f64 + 0.5 * (g + 1.0)), wg * 0.5 * h));
+            }
+        }
+    }
+    out
+}
+
 fn add_block(cols: &mut Vec<(usize, [f64; 9])>, j: usize, s: f64, d: &V3) {
     let mut b = [0.0; 9];
     for r in 0..3 {
@@ -108,7 +182,7 @@ impl Discretisation {
         let radius: Vec<f64> = spacing.iter().map(|h| h * params.support_factor).collect();
         let max_radius = radius.iter().cloned().fold(0.0, f64::max);
         let grid = PointGrid::new(&problem.nodes, max_radius)?;
-        let per_node = (params.cells * params.gauss).pow(2) as u64;
+        let per_node = ((params.angular + 32) * params.gauss) as u64;
         limits::check_alloc("shell quadrature points", per_node * n as u64, 512)?;
         let mut disc = Discretisation {
             problem,
@@ -154,7 +228,7 @@ impl Discretisation {
         let h = self.spacing[i];
         let rs = self.params.subdomain_factor * h;
         let (gp, gw) = gauss_legendre(self.params.gauss);
-        let m = self.params.cells;
+        let m = 2;
         let (m_scale, b_scale) = pr.material.scales();
         let pen = self.params.penalty;
         let mut out = NodeTerms::default();
@@ -163,40 +237,38 @@ impl Discretisation {
             let s = format!("{kind} of node {i}");
             move || s.clone()
         };
-        // sub-domain: the circle's bounding square clipped by the rectangle
-        let lo = [(xi[0] - rs).max(dom[0]), (xi[1] - rs).max(dom[2])];
-        let hi = [(xi[0] + rs).min(dom[1]), (xi[1] + rs).min(dom[3])];
-        let cw = [(hi[0] - lo[0]) / m as f64, (hi[1] - lo[1]) / m as f64];
-        for cy in 0..m {
-            for cx in 0..m {
-                for (gy, wy) in gp.iter().zip(gw) {
-                    for (gx, wx) in gp.iter().zip(gw) {
-                        let p = [
-                            lo[0] + cw[0] * (cx as f64 + 0.5 * (gx + 1.0)),
-                            lo[1] + cw[1] * (cy as f64 + 0.5 * (gy + 1.0)),
-                        ];
-                        let test = bump([p[0] - xi[0], p[1] - xi[1]], rs);
-                        if test[0] <= 0.0 {
-                            continue;
-                        }
-                        let rest = RestGeometry::new(pr.surface.at(p)).ok_or_else(|| {
-                            ShellError::Invalid(format!("degenerate rest surface at ({}, {})", p[0], p[1]))
-                        })?;
-                        let weight = wx * wy * 0.25 * cw[0] * cw[1] * rest.area;
-                        let s = self.shape_at(p, &what("a quadrature point"))?;
-                        for c in 0..3 {
-                            out.load[c] += weight * test[0] * pr.area_load[c];
-                        }
-                        out.quad.push(QuadPoint {
-                            weight,
-                            test,
-                            rest,
-                            slots: vec![0; s.nodes.len()],
-                            nodes: s.nodes,
-                            values: s.values,
-                        });
-                    }
+        // sub-domain: the circle clipped by the rectangle, in polar (ray) quadrature about the
+        // node: angular arcs split where the circle meets an edge or a corner lies inside it,
+        // Gauss along each arc and along each ray up to where it leaves the sub-domain
+        for (theta, w_theta) in arc_quadrature(xi, rs, dom, self.params.angular, gp, gw) {
+            let dir = [theta.cos(), theta.sin()];
+            let reach = ray_reach(xi, dir, rs, dom);
+            if reach <= 0.0 {
+                continue;
+            }
+            for (g, wr) in gp.iter().zip(gw) {
+                let rho = 0.5 * reach * (g + 1.0);
+                let p = [xi[0] + rho * dir[0], xi[1] + rho * dir[1]];
+                let test = bump([p[0] - xi[0], p[1] - xi[1]], rs);
+                if test[0] <= 0.0 {
+                    continue;
                 }
+                let rest = RestGeometry::new(pr.surface.at(p)).ok_or_else(|| {
+                    ShellError::Invalid(format!("degenerate rest surface at ({}, {})", p[0], p[1]))
+                })?;
+                let weight = w_theta * wr * 0.5 * reach * rho * rest.area;
+                let s = self.shape_at(p, &what("a quadrature point"))?;
+                for c in 0..3 {
+                    out.load[c] += weight * test[0] * pr.area_load[c];
+                }
+                out.quad.push(QuadPoint {
+                    weight,
+                    test,
+                    rest,
+                    slots: vec![0; s.nodes.len()],
+                    nodes: s.nodes,
+                    values: s.values,
+                });
             }
         }
         // essential conditions on the edges inside the sub-domain

@@ -59,9 +59,10 @@ pub struct ShellParameters {
     pub support_factor: f64,
     /// Radius of a node's MLPG sub-domain / its local spacing.
     pub subdomain_factor: f64,
-    /// Sub-cells per side of a sub-domain's bounding square (quadrature).
-    pub cells: usize,
-    /// Gauss points per sub-cell side (1 to 6).
+    /// Quadrature points around a whole sub-domain circle (a clipped circle's arcs get their
+    /// share, at least 4 per arc).
+    pub angular: usize,
+    /// Gauss points along each ray of a sub-domain, and along each edge segment (1 to 6).
     pub gauss: usize,
     /// Penalty factor: the penalty stiffness is this times the shell's own stiffness scale.
     pub penalty: f64,
@@ -79,8 +80,8 @@ impl Default for ShellParameters {
             basis: Basis::Quadratic,
             support_factor: 3.5,
             subdomain_factor: 1.0,
-            cells: 3,
-            gauss: 4,
+            angular: 16,
+            gauss: 6,
             penalty: 1e5,
             load_steps: 1,
             tolerance: 1e-9,
@@ -104,7 +105,7 @@ impl ShellParameters {
             }
         }
         let counts = [
-            ("cells", self.cells, 1, 16),
+            ("angular", self.angular, 4, 256),
             ("gauss", self.gauss, 1, 6),
             ("load_steps", self.load_steps, 1, 100_000),
             ("max_iterations", self.max_iterations, 1, 1000),
