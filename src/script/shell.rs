@@ -25,7 +25,7 @@ fn result_map(r: &BenchmarkResult) -> Map {
 /// Registers the shell functions.
 pub fn register(engine: &mut ApiBuilder) {
     function!(engine, "shell::benchmark", ["case: String", "points: int", "options: Map", "Map"],
-        "Runs one shell benchmark with `points` sample points along its longer side and the\nshell parameters `options` (fields of ShellParameters: basis, support_factor,\nsubdomain_factor, angular, gauss, penalty, ...; #{} for the defaults). `case`:\n\"plate_simply_supported\", \"plate_clamped\" (centre deflection / (q a⁴/D)), \"cantilever\"\n(tip angle, degrees, worst of q L³/B = 1 … 20), \"scordelis_lo\", \"pinched_cylinder\",\n\"pinched_hemisphere\". Returns #{name, points, value, reference, error (percent; degrees\nfor the cantilever), seconds, rows (cantilever: [q L³/B, angle, reference] per row)}.",
+        "Runs one shell benchmark with `points` sample points along its longer side and the\nshell parameters `options` (fields of ShellParameters: basis, support_factor,\ncell_factor, gauss, penalty, ...; #{} for the defaults). `case`:\n\"plate_simply_supported\", \"plate_clamped\" (centre deflection / (q a⁴/D)), \"cantilever\"\n(tip angle, degrees, worst of q L³/B = 1 … 20), \"scordelis_lo\", \"pinched_cylinder\",\n\"pinched_hemisphere\". Returns #{name, points, value, reference, error (percent; degrees\nfor the cantilever), seconds, rows (cantilever: [q L³/B, angle, reference] per row)}.",
         |case: &str, points: INT, options: Map| -> RResult<Map> {
             if !(3..=200).contains(&points) {
                 return Err(rt_err(format!("shell::benchmark: `points` must lie in [3, 200], got {points}")));

@@ -57,12 +57,10 @@ pub struct ShellParameters {
     pub basis: Basis,
     /// Support radius of a node / its local spacing (nearest-neighbour distance).
     pub support_factor: f64,
-    /// Radius of a node's MLPG sub-domain / its local spacing.
-    pub subdomain_factor: f64,
-    /// Quadrature points around a whole sub-domain circle (a clipped circle's arcs get their
-    /// share, at least 4 per arc).
-    pub angular: usize,
-    /// Gauss points along each ray of a sub-domain, and along each edge segment (1 to 6).
+    /// Background cells per side of the parameter rectangle's longer side, per sample point
+    /// along it (1: one cell per spacing).
+    pub cell_factor: f64,
+    /// Gauss points per background cell side, and per edge segment (1 to 6).
     pub gauss: usize,
     /// Penalty factor: the penalty stiffness is this times the shell's own stiffness scale.
     pub penalty: f64,
@@ -79,10 +77,9 @@ impl Default for ShellParameters {
         ShellParameters {
             basis: Basis::Quadratic,
             support_factor: 3.5,
-            subdomain_factor: 1.0,
-            angular: 16,
-            gauss: 6,
-            penalty: 1e5,
+            cell_factor: 1.0,
+            gauss: 4,
+            penalty: 1e3,
             load_steps: 1,
             tolerance: 1e-9,
             max_iterations: 30,
@@ -95,7 +92,7 @@ impl ShellParameters {
     pub fn validate(&self) -> Result<(), String> {
         let ranges: [(&str, f64, f64, f64); 4] = [
             ("support_factor", self.support_factor, 1.0, 10.0),
-            ("subdomain_factor", self.subdomain_factor, 0.1, 5.0),
+            ("cell_factor", self.cell_factor, 0.25, 8.0),
             ("penalty", self.penalty, 1.0, 1e12),
             ("tolerance", self.tolerance, 1e-15, 1e-2),
         ];
@@ -105,7 +102,6 @@ impl ShellParameters {
             }
         }
         let counts = [
-            ("angular", self.angular, 4, 256),
             ("gauss", self.gauss, 1, 6),
             ("load_steps", self.load_steps, 1, 100_000),
             ("max_iterations", self.max_iterations, 1, 1000),
