@@ -20,7 +20,7 @@ pub mod kes;
 pub mod limits;
 pub mod render;
 pub mod scenes;
-pub mod shell;
 #[cfg(feature = "scripting")]
 pub mod script;
+pub mod shell;
 pub mod tracking;

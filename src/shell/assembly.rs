@@ -14,7 +14,11 @@ use super::jet::NV;
 use super::kinematics::{energy_density, rest_locals};
 
 /// Weighted gradient and Hessian of the energy at every background point.
-fn point_jets(disc: &Discretisation, u: &[f64], tangent: bool) -> Vec<([f64; NV], Box<[[f64; NV]; NV]>)> {
+fn point_jets(
+    disc: &Discretisation,
+    u: &[f64],
+    tangent: bool,
+) -> Vec<([f64; NV], Box<[[f64; NV]; NV]>)> {
     let mat = &disc.problem.material;
     disc.quad
         .par_iter()
@@ -53,7 +57,11 @@ fn node_rows(
     tangent: bool,
 ) -> ([f64; 3], Vec<[f64; 9]>) {
     let mut r = [0.0; 3];
-    let mut k = if tangent { vec![[0.0; 9]; t.columns.len()] } else { Vec::new() };
+    let mut k = if tangent {
+        vec![[0.0; 9]; t.columns.len()]
+    } else {
+        Vec::new()
+    };
     for &(qi, a) in &t.quad {
         let q = &disc.quad[qi];
         let test = &q.values[a];

@@ -45,7 +45,13 @@ fn nodes_for(domain: [f64; 4], n: usize) -> Vec<[f64; 2]> {
     grid_nodes(domain, n1, n2.max(3))
 }
 
-fn result(name: &str, disc: &Discretisation, value: f64, reference: f64, t0: Instant) -> BenchmarkResult {
+fn result(
+    name: &str,
+    disc: &Discretisation,
+    value: f64,
+    reference: f64,
+    t0: Instant,
+) -> BenchmarkResult {
     BenchmarkResult {
         name: name.to_string(),
         points: disc.len(),
@@ -60,12 +66,20 @@ fn result(name: &str, disc: &Discretisation, value: f64, reference: f64, t0: Ins
 /// grid, simply supported (w = 0 and no in-plane motion on the edges) or clamped (also no
 /// rotation): the centre deflection in units of q a⁴/D against 0.00406 (simply supported) and
 /// 0.00126 (clamped) (Timoshenko & Woinowsky-Krieger, tables 8 and 35).
-pub fn square_plate(n: usize, clamped: bool, params: ShellParameters) -> Result<BenchmarkResult, ShellError> {
+pub fn square_plate(
+    n: usize,
+    clamped: bool,
+    params: ShellParameters,
+) -> Result<BenchmarkResult, ShellError> {
     let t0 = Instant::now();
     let (a, t, e, nu, q) = (1.0, 0.01, 1e9, 0.3, 1.0);
     let material = ShellMaterial::isotropic(e, nu, t, 0.0).map_err(ShellError::Invalid)?;
     let d = e * t * t * t / (12.0 * (1.0 - nu * nu));
-    let mut edge = vec![Constraint::Value(X), Constraint::Value(Y), Constraint::Value(Z)];
+    let mut edge = vec![
+        Constraint::Value(X),
+        Constraint::Value(Y),
+        Constraint::Value(Z),
+    ];
     if clamped {
         edge.push(Constraint::Slope(N));
     }
@@ -147,7 +161,10 @@ pub fn heavy_cantilever(
     let mut fail = None;
     solve_static(&disc, &mut u, 0.0, 1.0, &mut |lambda, u| {
         let lam = lambda * lam_max;
-        if let Some(&(_, reference)) = ELASTICA_TIP_ANGLES.iter().find(|(x, _)| (x - lam).abs() < 1e-9) {
+        if let Some(&(_, reference)) = ELASTICA_TIP_ANGLES
+            .iter()
+            .find(|(x, _)| (x - lam).abs() < 1e-9)
+        {
             match disc.field_at([l, 0.5 * b], u) {
                 Ok(f) => {
                     let a1 = nalgebra::Vector3::x() + f[1];
@@ -240,10 +257,14 @@ pub fn pinched_cylinder(n: usize, params: ShellParameters) -> Result<BenchmarkRe
 /// shell), one quarter (symmetry planes x = 0 and y = 0, a vertical pin against the free
 /// translation), `n` points along the equator: the displacement under the load along it
 /// against 0.0924.
-pub fn pinched_hemisphere(n: usize, params: ShellParameters) -> Result<BenchmarkResult, ShellError> {
+pub fn pinched_hemisphere(
+    n: usize,
+    params: ShellParameters,
+) -> Result<BenchmarkResult, ShellError> {
     let t0 = Instant::now();
     let r = 10.0;
-    let material = ShellMaterial::isotropic(6.825e7, 0.3, 0.04, 0.0).map_err(ShellError::Invalid)?;
+    let material =
+        ShellMaterial::isotropic(6.825e7, 0.3, 0.04, 0.0).map_err(ShellError::Invalid)?;
     let domain = [0.0, r * PI / 2.0, 0.0, r * 72f64.to_radians()];
     let problem = ShellProblem {
         surface: Surface::Sphere { radius: r },

@@ -68,7 +68,13 @@ fn resolve(d: Direction, normal: &V3) -> V3 {
 }
 
 /// A penalty term α ∫ (s_J u_J · d)(s_K δu_K · d): blocks for every pair of the point's nodes.
-fn add_pairs(blocks: &mut [Vec<(usize, [f64; 9])>], nodes: &[usize], s: &[f64], scale: f64, d: &V3) {
+fn add_pairs(
+    blocks: &mut [Vec<(usize, [f64; 9])>],
+    nodes: &[usize],
+    s: &[f64],
+    scale: f64,
+    d: &V3,
+) {
     for (a, &j) in nodes.iter().enumerate() {
         for (b, &k) in nodes.iter().enumerate() {
             let c = scale * s[a] * s[b];
@@ -89,7 +95,10 @@ fn add_pairs(blocks: &mut [Vec<(usize, [f64; 9])>], nodes: &[usize], s: &[f64], 
 impl Discretisation {
     /// Builds the discretisation: errors name the bad parameter, or the point whose shape
     /// functions cannot be built.
-    pub fn new(problem: ShellProblem, params: ShellParameters) -> Result<Discretisation, ShellError> {
+    pub fn new(
+        problem: ShellProblem,
+        params: ShellParameters,
+    ) -> Result<Discretisation, ShellError> {
         params.validate().map_err(ShellError::Invalid)?;
         problem.surface.validate().map_err(ShellError::Invalid)?;
         let d = problem.domain;
@@ -99,10 +108,19 @@ impl Discretisation {
             )));
         }
         let n = problem.nodes.len();
-        limits::check_count("shell sample points", n as u64, "max_particles", limits::get().max_particles)?;
+        limits::check_count(
+            "shell sample points",
+            n as u64,
+            "max_particles",
+            limits::get().max_particles,
+        )?;
         let tol = 1e-9 * (d[1] - d[0]).max(d[3] - d[2]);
         for (i, p) in problem.nodes.iter().enumerate() {
-            if !(p[0] >= d[0] - tol && p[0] <= d[1] + tol && p[1] >= d[2] - tol && p[1] <= d[3] + tol) {
+            if !(p[0] >= d[0] - tol
+                && p[0] <= d[1] + tol
+                && p[1] >= d[2] - tol
+                && p[1] <= d[3] + tol)
+            {
                 return Err(ShellError::Invalid(format!(
                     "sample point {i} ({}, {}) lies outside the parameter rectangle {d:?}",
                     p[0], p[1]
@@ -139,7 +157,10 @@ impl Discretisation {
     fn cell_points(&self, cells: [usize; 2]) -> Result<Vec<QuadPoint>, ShellError> {
         let d = self.problem.domain;
         let (gp, gw) = gauss_legendre(self.params.gauss);
-        let cw = [(d[1] - d[0]) / cells[0] as f64, (d[3] - d[2]) / cells[1] as f64];
+        let cw = [
+            (d[1] - d[0]) / cells[0] as f64,
+            (d[3] - d[2]) / cells[1] as f64,
+        ];
         let per_cell = |c: usize| -> Result<Vec<QuadPoint>, ShellError> {
             let (cx, cy) = (c % cells[0], c / cells[0]);
             let mut out = Vec::with_capacity(gp.len() * gp.len());
@@ -150,7 +171,10 @@ impl Discretisation {
                         d[2] + cw[1] * (cy as f64 + 0.5 * (gy + 1.0)),
                     ];
                     let rest = RestGeometry::new(self.problem.surface.at(p)).ok_or_else(|| {
-                        ShellError::Invalid(format!("degenerate rest surface at ({}, {})", p[0], p[1]))
+                        ShellError::Invalid(format!(
+                            "degenerate rest surface at ({}, {})",
+                            p[0], p[1]
+                        ))
                     })?;
                     let s = self.shape_at(p, &|| format!("quadrature point of cell {cx}, {cy}"))?;
                     out.push(QuadPoint {
@@ -163,8 +187,10 @@ impl Discretisation {
             }
             Ok(out)
         };
-        let parts: Result<Vec<Vec<QuadPoint>>, ShellError> =
-            (0..cells[0] * cells[1]).into_par_iter().map(per_cell).collect();
+        let parts: Result<Vec<Vec<QuadPoint>>, ShellError> = (0..cells[0] * cells[1])
+            .into_par_iter()
+            .map(per_cell)
+            .collect();
         Ok(parts?.concat())
     }
 
@@ -203,11 +229,16 @@ impl Discretisation {
                     p[o] = dom[2 * o] + len * (sgi as f64 + 0.5 * (g + 1.0));
                     let sp = pr.surface.at(p);
                     let rest = RestGeometry::new(sp).ok_or_else(|| {
-                        ShellError::Invalid(format!("degenerate rest surface at ({}, {})", p[0], p[1]))
+                        ShellError::Invalid(format!(
+                            "degenerate rest surface at ({}, {})",
+                            p[0], p[1]
+                        ))
                     })?;
                     let line = w * 0.5 * len * sp.d1[o].norm();
                     let across = sp.d1[k].norm();
-                    let s = self.shape_at(p, &|| format!("a point of edge {}", super::problem::EDGE_NAMES[e]))?;
+                    let s = self.shape_at(p, &|| {
+                        format!("a point of edge {}", super::problem::EDGE_NAMES[e])
+                    })?;
                     for con in constraints {
                         let (deriv, dir) = match *con {
                             Constraint::Value(d) => (0, d),
@@ -218,13 +249,21 @@ impl Discretisation {
                         // membrane for the tangential part
                         let dn = dv.dot(&rest.normal).powi(2);
                         let alpha = match *con {
-                            Constraint::Value(_) => pen * (m_scale / h * (1.0 - dn) + b_scale / h.powi(3) * dn),
+                            Constraint::Value(_) => {
+                                pen * (m_scale / h * (1.0 - dn) + b_scale / h.powi(3) * dn)
+                            }
                             Constraint::Slope(_) => pen * b_scale / h,
                         };
                         let sv: Vec<f64> = s
                             .values
                             .iter()
-                            .map(|v| if deriv == 0 { v[0] } else { sign * v[deriv] / across })
+                            .map(|v| {
+                                if deriv == 0 {
+                                    v[0]
+                                } else {
+                                    sign * v[deriv] / across
+                                }
+                            })
                             .collect();
                         add_pairs(&mut blocks, &s.nodes, &sv, alpha * line, &dv);
                     }
@@ -285,10 +324,21 @@ impl Discretisation {
     }
 
     /// The MLS shape functions at a parameter point (`what` names it in errors).
-    pub fn shape_at(&self, x: [f64; 2], what: &dyn Fn() -> String) -> Result<ShapeValues, ShellError> {
+    pub fn shape_at(
+        &self,
+        x: [f64; 2],
+        what: &dyn Fn() -> String,
+    ) -> Result<ShapeValues, ShellError> {
         let mut cand = Vec::new();
         self.grid.within(x, self.max_radius, &mut cand);
-        shape_functions(x, &self.problem.nodes, &self.radius, &cand, self.params.basis, what)
+        shape_functions(
+            x,
+            &self.problem.nodes,
+            &self.radius,
+            &cand,
+            self.params.basis,
+            what,
+        )
     }
 
     /// The displacement at a parameter point from the nodal parameters `u` (3 per node).

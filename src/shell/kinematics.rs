@@ -157,6 +157,11 @@ mod tests {
         l[8] = kappa; // a₁₁ = (0, 0, κ): pure curvature, no stretch
         let w = energy_density(&l, &flat, &mat);
         let d = mat.bending[0][0];
-        assert!((w.v - 0.5 * d * kappa * kappa).abs() < 1e-12 * d, "{} vs {}", w.v, 0.5 * d * kappa * kappa);
+        assert!(
+            (w.v - 0.5 * d * kappa * kappa).abs() < 1e-12 * d,
+            "{} vs {}",
+            w.v,
+            0.5 * d * kappa * kappa
+        );
     }
 }

@@ -21,7 +21,9 @@ impl ShellMaterial {
     /// areal density `density` (kg/m²). D_m = E t/(1 − ν²) C, D_b = E t³/(12(1 − ν²)) C.
     pub fn isotropic(e: f64, nu: f64, t: f64, density: f64) -> Result<ShellMaterial, String> {
         if !(e.is_finite() && e > 0.0) {
-            return Err(format!("Young's modulus must be positive and finite, got {e}"));
+            return Err(format!(
+                "Young's modulus must be positive and finite, got {e}"
+            ));
         }
         if !(nu.is_finite() && (-1.0..0.5).contains(&nu)) {
             return Err(format!("Poisson's ratio must lie in [-1, 0.5), got {nu}"));
@@ -33,7 +35,11 @@ impl ShellMaterial {
             return Err(format!("density must be finite and ≥ 0, got {density}"));
         }
         let c = e / (1.0 - nu * nu);
-        let law = [[c, c * nu, 0.0], [c * nu, c, 0.0], [0.0, 0.0, 0.5 * c * (1.0 - nu)]];
+        let law = [
+            [c, c * nu, 0.0],
+            [c * nu, c, 0.0],
+            [0.0, 0.0, 0.5 * c * (1.0 - nu)],
+        ];
         let scale = |s: f64| law.map(|row| row.map(|v| v * s));
         Ok(ShellMaterial {
             membrane: scale(t),
@@ -49,7 +55,9 @@ impl ShellMaterial {
     pub fn from_fabric(f: &FabricParameters) -> Result<ShellMaterial, String> {
         f.validate()?;
         if f.stretch_warp <= 0.0 || f.stretch_weft <= 0.0 || f.shear <= 0.0 {
-            return Err("a shell fabric needs positive stretch_warp, stretch_weft and shear".into());
+            return Err(
+                "a shell fabric needs positive stretch_warp, stretch_weft and shear".into(),
+            );
         }
         let twist = 0.5 * (f.bend_warp * f.bend_weft).sqrt();
         Ok(ShellMaterial {
@@ -58,7 +66,11 @@ impl ShellMaterial {
                 [0.0, f.stretch_weft, 0.0],
                 [0.0, 0.0, f.shear],
             ],
-            bending: [[f.bend_warp, 0.0, 0.0], [0.0, f.bend_weft, 0.0], [0.0, 0.0, twist]],
+            bending: [
+                [f.bend_warp, 0.0, 0.0],
+                [0.0, f.bend_weft, 0.0],
+                [0.0, 0.0, twist],
+            ],
             density: f.density,
         })
     }

@@ -120,12 +120,24 @@ pub fn shape_functions(
         )));
     }
     // A and its derivatives, basis about x scaled by `scale`
-    let mut a = [DMatrix::zeros(m, m), DMatrix::zeros(m, m), DMatrix::zeros(m, m)];
-    let mut a2 = [DMatrix::zeros(m, m), DMatrix::zeros(m, m), DMatrix::zeros(m, m)];
+    let mut a = [
+        DMatrix::zeros(m, m),
+        DMatrix::zeros(m, m),
+        DMatrix::zeros(m, m),
+    ];
+    let mut a2 = [
+        DMatrix::zeros(m, m),
+        DMatrix::zeros(m, m),
+        DMatrix::zeros(m, m),
+    ];
     let mut ps = Vec::with_capacity(kept.len());
     let mut p = vec![0.0; m];
     for (k, &i) in kept.iter().enumerate() {
-        basis.eval((points[i][0] - x[0]) / scale, (points[i][1] - x[1]) / scale, &mut p);
+        basis.eval(
+            (points[i][0] - x[0]) / scale,
+            (points[i][1] - x[1]) / scale,
+            &mut p,
+        );
         let pp = DVector::from_column_slice(&p);
         let outer = &pp * pp.transpose();
         let w = weights[k];
@@ -141,7 +153,9 @@ pub fn shape_functions(
     let (lo, hi) = eig
         .eigenvalues
         .iter()
-        .fold((f64::INFINITY, 0.0f64), |(l, h), &e| (l.min(e), h.max(e.abs())));
+        .fold((f64::INFINITY, 0.0f64), |(l, h), &e| {
+            (l.min(e), h.max(e.abs()))
+        });
     if !(lo > 1e-12 * hi) {
         return Err(fail(format!(
             "singular moment matrix (eigenvalue ratio {:.3e}; {} neighbours, likely on a line or too few for the {:?} basis)",
@@ -286,6 +300,9 @@ mod tests {
         })
         .unwrap_err()
         .to_string();
-        assert!(e.contains("singular moment matrix") && e.contains("node 3"), "{e}");
+        assert!(
+            e.contains("singular moment matrix") && e.contains("node 3"),
+            "{e}"
+        );
     }
 }

@@ -98,7 +98,9 @@ impl ShellParameters {
         ];
         for (name, v, lo, hi) in ranges {
             if !(v.is_finite() && v >= lo && v <= hi) {
-                return Err(format!("shell parameter `{name}` must lie in [{lo}, {hi}], got {v}"));
+                return Err(format!(
+                    "shell parameter `{name}` must lie in [{lo}, {hi}], got {v}"
+                ));
             }
         }
         let counts = [
@@ -108,7 +110,9 @@ impl ShellParameters {
         ];
         for (name, v, lo, hi) in counts {
             if v < lo || v > hi {
-                return Err(format!("shell parameter `{name}` must lie in [{lo}, {hi}], got {v}"));
+                return Err(format!(
+                    "shell parameter `{name}` must lie in [{lo}, {hi}], got {v}"
+                ));
             }
         }
         Ok(())
@@ -135,10 +139,17 @@ pub fn grid_nodes(domain: [f64; 4], n1: usize, n2: usize) -> Vec<[f64; 2]> {
 pub fn gauss_legendre(n: usize) -> (&'static [f64], &'static [f64]) {
     match n {
         1 => (&[0.0], &[2.0]),
-        2 => (&[-0.577_350_269_189_625_8, 0.577_350_269_189_625_8], &[1.0, 1.0]),
+        2 => (
+            &[-0.577_350_269_189_625_8, 0.577_350_269_189_625_8],
+            &[1.0, 1.0],
+        ),
         3 => (
             &[-0.774_596_669_241_483_4, 0.0, 0.774_596_669_241_483_4],
-            &[0.555_555_555_555_555_6, 0.888_888_888_888_888_9, 0.555_555_555_555_555_6],
+            &[
+                0.555_555_555_555_555_6,
+                0.888_888_888_888_888_9,
+                0.555_555_555_555_555_6,
+            ],
         ),
         4 => (
             &[

@@ -34,7 +34,8 @@ fn newton_step(disc: &Discretisation, u: &mut [f64], lambda: f64) -> Result<f64,
     for i in 0..u.len() {
         if !du[i].is_finite() {
             return Err(ShellError::Solver(
-                "the tangent is singular (a rigid-body motion left free? add supports or pins)".into(),
+                "the tangent is singular (a rigid-body motion left free? add supports or pins)"
+                    .into(),
             ));
         }
         u[i] += du[i];

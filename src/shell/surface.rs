@@ -59,7 +59,10 @@ impl Surface {
                 let (sp, cp) = (xi[1] / r).sin_cos();
                 SurfacePoint {
                     x: V3::new(r * cp * cl, r * cp * sl, r * sp),
-                    d1: [V3::new(-cp * sl, cp * cl, 0.0), V3::new(-sp * cl, -sp * sl, cp)],
+                    d1: [
+                        V3::new(-cp * sl, cp * cl, 0.0),
+                        V3::new(-sp * cl, -sp * sl, cp),
+                    ],
                     d2: [
                         V3::new(-cp * cl, -cp * sl, 0.0) / r,
                         V3::new(sp * sl, -sp * cl, 0.0) / r,
@@ -78,7 +81,9 @@ impl Surface {
                 if radius.is_finite() && radius > 0.0 {
                     Ok(())
                 } else {
-                    Err(format!("surface radius must be positive and finite, got {radius}"))
+                    Err(format!(
+                        "surface radius must be positive and finite, got {radius}"
+                    ))
                 }
             }
         }
