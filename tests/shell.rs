@@ -72,7 +72,10 @@ fn too_small_a_support_is_an_error_naming_the_point() {
     )
     .unwrap_err()
     .to_string();
-    assert!(e.contains("quadrature point of cell 0, 0") && e.contains("neighbours"), "{e}");
+    assert!(
+        e.contains("quadrature point of cell 0, 0") && e.contains("neighbours"),
+        "{e}"
+    );
 }
 
 #[test]
