@@ -13,12 +13,11 @@ use super::error::ShellError;
 use super::jet::NV;
 use super::kinematics::{energy_density, rest_locals};
 
+/// The weighted gradient and Hessian of the energy at one background point.
+type PointJet = ([f64; NV], Box<[[f64; NV]; NV]>);
+
 /// Weighted gradient and Hessian of the energy at every background point.
-fn point_jets(
-    disc: &Discretisation,
-    u: &[f64],
-    tangent: bool,
-) -> Vec<([f64; NV], Box<[[f64; NV]; NV]>)> {
+fn point_jets(disc: &Discretisation, u: &[f64], tangent: bool) -> Vec<PointJet> {
     let mat = &disc.problem.material;
     disc.quad
         .par_iter()
@@ -51,7 +50,7 @@ fn point_jets(
 fn node_rows(
     t: &NodeTerms,
     disc: &Discretisation,
-    jets: &[([f64; NV], Box<[[f64; NV]; NV]>)],
+    jets: &[PointJet],
     u: &[f64],
     lambda: f64,
     tangent: bool,

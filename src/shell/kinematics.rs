@@ -23,7 +23,7 @@ pub struct RestGeometry {
     pub metric: [f64; 3],
     /// Rest curvature B₁₁, B₁₂, B₂₂ (with the normal X,₁×X,₂/|X,₁×X,₂|).
     pub curvature: [f64; 3],
-    /// t[i][α] = e_i·A^α: covariant strain components → local Cartesian ones.
+    /// `t[i][α]` = e_i·A^α: covariant strain components → local Cartesian ones.
     pub to_local: [[f64; 2]; 2],
     /// Area element |X,₁ × X,₂| (rest area per unit parameter area).
     pub area: f64,
@@ -37,7 +37,7 @@ impl RestGeometry {
         let [g1, g2] = point.d1;
         let n = g1.cross(&g2);
         let area = n.norm();
-        if !(area > 1e-300) {
+        if area.is_nan() || area <= 1e-300 {
             return None;
         }
         let normal = n / area;

@@ -156,7 +156,7 @@ pub fn shape_functions(
         .fold((f64::INFINITY, 0.0f64), |(l, h), &e| {
             (l.min(e), h.max(e.abs()))
         });
-    if !(lo > 1e-12 * hi) {
+    if lo.is_nan() || hi.is_nan() || lo <= 1e-12 * hi {
         return Err(fail(format!(
             "singular moment matrix (eigenvalue ratio {:.3e}; {} neighbours, likely on a line or too few for the {:?} basis)",
             lo / hi.max(f64::MIN_POSITIVE),
