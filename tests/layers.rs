@@ -561,7 +561,7 @@ const LAYERS: &[&[&str]] = &[
     &["geometry"],
     &["render"],
     &["body"],
-    &["cloth"],
+    &["cloth", "shell"],
     &["contact"],
     &["garment", "kes"],
     &["tracking", "face", "facade"],

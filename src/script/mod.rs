@@ -45,6 +45,7 @@ pub mod paths;
 pub mod repl;
 pub mod run;
 pub mod sandbox;
+pub mod shell;
 pub mod sim;
 pub mod sim_run;
 pub mod tracking;
@@ -189,6 +190,7 @@ pub fn build_engine_with(limits: EngineLimits) -> Engine {
     face::register(&mut engine);
     tracking_sequence::register(&mut engine);
     kes::register(&mut engine);
+    shell::register(&mut engine);
     paths::register(&mut engine);
     engine.finish()
 }
