@@ -73,7 +73,8 @@ pub fn garment(edge_mm: usize) -> Result<Simulation, ClothError> {
         )));
     }
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/patterns/aaron.garment.json");
-    let pattern = crate::garment::read_garment(&file).map_err(|e| err(&file.display().to_string(), &e))?;
+    let pattern =
+        crate::garment::read_garment(&file).map_err(|e| err(&file.display().to_string(), &e))?;
     let dir = crate::geometry::files::data_dir().join("bodies/makehuman");
     let man = crate::body::Mannequin::load_makehuman(&dir)
         .map_err(|e| err(&dir.display().to_string(), &e))?;

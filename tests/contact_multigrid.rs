@@ -29,7 +29,9 @@ fn drape(n: usize, params: SimulationParameters) -> Simulation {
     .unwrap();
     let contact = sim.add_contact();
     contact.settings.thickness = 0.015;
-    contact.bodies.push(Body::sphere(Vec3::zeros(), 0.3).unwrap());
+    contact
+        .bodies
+        .push(Body::sphere(Vec3::zeros(), 0.3).unwrap());
     sim
 }
 
@@ -121,8 +123,47 @@ fn drape_cg_iterations_stay_near_the_hangs() {
     assert!(contact.len() >= 30, "{} steps in contact", contact.len());
     let mean = contact.iter().sum::<f64>() / contact.len() as f64;
     eprintln!("drape 48²: {mean:.2} CG iterations per step in contact");
-    assert!(mean <= MAX_MEAN, "{mean:.2} CG iterations per step in contact");
+    assert!(
+        mean <= MAX_MEAN,
+        "{mean:.2} CG iterations per step in contact"
+    );
 }
 
 /// Bound on the drape's mean iterations in contact (measured: see docs/cloth-solver.md).
 const MAX_MEAN: f64 = 6.0;
+
+/// The Galerkin product of the identity under the bilinear transfer of a 3-point line onto 2
+/// points is Pᵀ P, written out by hand: [[1.25, 0.25], [0.25, 1.25]] (times I).
+#[test]
+fn galerkin_of_identity_is_p_transpose_p() {
+    use emilion::cloth::solver::bcsr::{Bcsr3, Sym3f};
+    use emilion::cloth::solver::galerkin::{
+        coarse_pattern, fill, FineConstraints, GalerkinTransfer,
+    };
+    // fine 3×1 grid → coarse 2×1: taps 1, (½, ½), 1
+    let taps = vec![
+        [(0, 1.0), (1, 0.0), (0, 0.0), (1, 0.0)],
+        [(0, 0.5), (1, 0.5), (0, 0.0), (1, 0.0)],
+        [(0, 0.0), (1, 1.0), (0, 0.0), (1, 0.0)],
+    ];
+    let t = GalerkinTransfer::new(taps, (2, 1));
+    let mut fine = Bcsr3::with_pattern(3, &[]);
+    fine.enable_mirror32();
+    for i in 0..3 {
+        let k = fine.diag[i];
+        fine.values32[k] = Sym3f([1.0, 0.0, 0.0, 1.0, 0.0, 1.0]);
+    }
+    let mut coarse = coarse_pattern(2, 1);
+    coarse.enable_mirror32();
+    let none = FineConstraints {
+        pen: &[],
+        fixed: &[],
+    };
+    fill(&fine, none, &t, &mut coarse);
+    let d = coarse.values32[coarse.diag[0]].0[0];
+    let o = coarse.values32[coarse.slot(0, 1).unwrap()].0[0];
+    assert!(
+        (d - 1.25).abs() < 1e-7 && (o - 0.25).abs() < 1e-7,
+        "{d} {o}"
+    );
+}

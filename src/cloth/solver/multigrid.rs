@@ -7,6 +7,7 @@
 
 use super::assembly::{Assembly, AssemblyInputs};
 use super::bcsr::{Bcsr3, Sym3f};
+pub use super::galerkin::ContactCoarsening;
 use super::galerkin::{self, FineConstraints, GalerkinTransfer};
 use super::line_solver::{weft_order, LineDir, LineSolver};
 use super::parallel::{for_each_mut, PAR_MIN};
@@ -212,31 +213,6 @@ struct GalerkinOp {
     from_fine: GalerkinTransfer,
 }
 
-/// How the coarse levels see the contact constraints.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ContactCoarsening {
-    /// Galerkin coarse operators of the penalised, fixed-filtered fine operator (the default).
-    Galerkin,
-    /// Rediscretised coarse cloths with the constraint of the fine particle under each coarse
-    /// one, the transfers projecting out the constrained directions.
-    Projected,
-    /// Rediscretised coarse cloths with the constraint of the fine particle under each coarse
-    /// one (before issue 53).
-    Injected,
-}
-
-impl ContactCoarsening {
-    /// The choice of `EMILION_MG_CONTACT` (`galerkin`, `projected`, `injected`; for experiments),
-    /// or the default.
-    fn from_env() -> Self {
-        match std::env::var("EMILION_MG_CONTACT").as_deref() {
-            Ok("projected") => ContactCoarsening::Projected,
-            Ok("injected") => ContactCoarsening::Injected,
-            _ => ContactCoarsening::Galerkin,
-        }
-    }
-}
-
 /// The multigrid hierarchy of one grid cloth.
 #[derive(Debug)]
 pub struct Multigrid {
@@ -393,8 +369,7 @@ impl Multigrid {
             let pen = l0.penalized.then_some(&l0.pen[..]);
             l0.lines.factor(a, &l0.fixed, pen);
         }
-        self.galerkin_now =
-            self.levels[0].penalized && self.contact == ContactCoarsening::Galerkin;
+        self.galerkin_now = self.levels[0].penalized && self.contact == ContactCoarsening::Galerkin;
         if self.galerkin_now {
             self.setup_galerkin(a);
             self.timing.0 += t0.elapsed().as_secs_f64();
@@ -459,10 +434,22 @@ impl Multigrid {
             });
             let (fa, cons) = if l == 1 {
                 let pen: &[Sym3f] = if f.penalized { &f.pen } else { &[] };
-                (a, FineConstraints { pen, fixed: &f.fixed })
+                (
+                    a,
+                    FineConstraints {
+                        pen,
+                        fixed: &f.fixed,
+                    },
+                )
             } else {
                 let fa = &f.gal.as_ref().expect("finer Galerkin level").a;
-                (fa, FineConstraints { pen: &[], fixed: &[] })
+                (
+                    fa,
+                    FineConstraints {
+                        pen: &[],
+                        fixed: &[],
+                    },
+                )
             };
             galerkin::fill(fa, cons, &gal.from_fine, &mut gal.a);
             c.fixed.fill(false);
