@@ -338,6 +338,9 @@ impl Multigrid {
     /// filter's fixed particles are fixed on every level; its velocity-constrained directions
     /// (contacts) enter each level's operator as stiff penalty springs κ n nᵀ, so that the
     /// V-cycle approximates the inverse of the constrained system rather than the free one.
+    /// While any particle is in contact the coarse levels are instead Galerkin products of
+    /// the level above ([`ContactCoarsening::Galerkin`], the default), which carry every
+    /// constraint down exactly.
     pub fn setup(
         &mut self,
         a: &Bcsr3,
