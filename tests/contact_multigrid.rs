@@ -171,8 +171,7 @@ fn galerkin_of_identity_is_p_transpose_p() {
     let t = GalerkinTransfer::new(taps, (2, 1));
     let mut fine = Bcsr3::with_pattern(3, &[]);
     fine.enable_mirror32();
-    for i in 0..3 {
-        let k = fine.diag[i];
+    for k in fine.diag.clone() {
         fine.values32[k] = Sym3f([1.0, 0.0, 0.0, 1.0, 0.0, 1.0]);
     }
     let mut coarse = coarse_pattern(2, 1);
