@@ -127,7 +127,8 @@ fn drape_is_bit_identical_on_one_and_two_threads() {
 
 /// Regression (issue 53): the coarse levels did not see the contact constraints, and the
 /// drape needed 9.0 CG iterations per step at 64² over its first 24 frames (19.1 at 128²)
-/// against the hang's 2.4.
+/// against the hang's 2.4. Here, at 48² over 60 steps: 7.88 per step in contact with the
+/// rediscretised coarse levels (`EMILION_MG_CONTACT=injected`), 4.28 with the Galerkin ones.
 #[test]
 fn drape_cg_iterations_stay_near_the_hangs() {
     let mut sim = drape(48, SimulationParameters::default());
