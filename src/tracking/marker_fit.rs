@@ -17,7 +17,7 @@ use super::marker_set::MarkerSet;
 use super::puppet::{Proportions, Puppet, DRIVEN_BONES, PARAM_COUNT};
 use crate::body::{Mannequin, MarkerTrial, Pose};
 use crate::geometry::least_squares::{
-    self, DampingUpdate, DiagonalDamping, LeastSquares, Schedule, Tries,
+    self, BoundedDifferences, DampingUpdate, DiagonalDamping, LeastSquares, Schedule, Tries,
 };
 use crate::geometry::Vec3;
 
@@ -557,8 +557,7 @@ impl LeastSquares for MarkerIk<'_> {
     }
 
     fn jacobian(&mut self, p: &Vec<f64>, r: &DVector<f64>, jac: &mut DMatrix<f64>) {
-        let mut q = p.clone();
-        let mut r2 = DVector::zeros(self.rows);
+        let mut differences = BoundedDifferences::new(self.rows);
         let o = 3 * self.seen.len();
         for i in 0..PARAM_COUNT {
             if !self.active[i] {
@@ -566,15 +565,11 @@ impl LeastSquares for MarkerIk<'_> {
                 jac[(o + i, i)] = PRIOR;
                 continue;
             }
-            q.copy_from_slice(p);
-            let h = if p[i] + 1e-6 > self.puppet.params()[i].hi {
-                -1e-6
-            } else {
-                1e-6
-            };
-            q[i] += h;
-            self.residuals(&q, &mut r2);
-            jac.set_column(i, &((&r2 - r) / h));
+            let hi = self.puppet.params()[i].hi;
+            jac.set_column(
+                i,
+                differences.column(p, i, hi, r, |q, out| self.residuals(q, out)),
+            );
         }
     }
 
