@@ -64,6 +64,20 @@ pub struct BenchResult {
     pub intersections: usize,
     /// Smallest vertex–body distance over the run (m; null without bodies).
     pub min_distance: Option<f64>,
+    /// Bytes of the implicit system's matrix (pattern, blocks, single-precision mirrors) per
+    /// vertex.
+    pub matrix_bytes_per_vertex: f64,
+    /// The process's peak resident memory so far (MB, `VmHWM`; null where the system does not
+    /// say): it covers every case run before this one in the same process.
+    pub peak_rss_mb: Option<f64>,
+}
+
+/// The process's peak resident set size in MB, from `/proc/self/status` (Linux only).
+pub fn peak_rss_mb() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb / 1024.0)
 }
 
 /// Runs the hang scene at `n` × `n` for `frames` frames of 5 substeps, `runs` times after one
@@ -75,6 +89,8 @@ pub fn bench_hang(n: usize, frames: u32, runs: usize) -> Result<BenchResult, Clo
 /// Runs scene `scene` ("hang", "drape" or "hang_self") at `n` × `n` for `frames` frames of 5
 /// substeps, `runs` times after one warm-up run, and returns the median run. A size over the
 /// limit `max_particles` or a frame count over `max_frames` is refused before anything is built.
+/// Scene "garment" is the A-shirt on the mannequin ([`scenes::garment`]) with `n` its edge length
+/// in millimetres, run for `frames` × 5 of its own steps from the pattern (sewing, then drape).
 pub fn bench_scene(
     scene: &str,
     n: usize,
@@ -84,21 +100,27 @@ pub fn bench_scene(
     let substeps = 5;
     let runs = runs.max(1);
     let lim = limits::get();
-    let particles = (n as f64) * (n as f64);
+    let particles = if scene == "garment" {
+        1.0
+    } else {
+        (n as f64) * (n as f64)
+    };
     let what = format!("bench size {n} × {n} particles");
     limits::check(&what, particles, "max_particles", lim.max_particles).map_err(limit_err)?;
     limits::check_count("bench frames", frames as u64, "max_frames", lim.max_frames)
         .map_err(limit_err)?;
     let mut results = Vec::new();
     let mut contact = Vec::new();
+    let (mut vertices, mut matrix_bytes) = (n * n, 0);
     for r in 0..=runs {
         let mut sim = match scene {
             "hang" => scenes::hang(n)?,
             "drape" => scenes::drape(n)?,
             "hang_self" => scenes::hang_self(n)?,
+            "garment" => scenes::garment(n)?,
             other => {
                 return Err(ClothError::Parameter(format!(
-                    "unknown bench scene `{other}` (hang, drape, hang_self)"
+                    "unknown bench scene `{other}` (hang, drape, hang_self, garment)"
                 )))
             }
         };
@@ -110,6 +132,8 @@ pub fn bench_scene(
         sim.run_steps(steps, |_, _| Ok(()))?;
         let ms = t0.elapsed().as_secs_f64() * 1e3 / steps as f64;
         if r > 0 {
+            vertices = sim.particle_count();
+            matrix_bytes = sim.system_matrix_bytes();
             let x = sim.state.x.clone();
             let last = sim.contact_mut().report(&x);
             let s = &sim.stats;
@@ -164,7 +188,7 @@ pub fn bench_scene(
     Ok(BenchResult {
         scene: scene.into(),
         n,
-        vertices: n * n,
+        vertices,
         frames,
         substeps,
         substep_ms: med.0,
@@ -185,5 +209,7 @@ pub fn bench_scene(
         penetrating: c.2,
         intersections: c.3,
         min_distance: c.4,
+        matrix_bytes_per_vertex: matrix_bytes as f64 / vertices.max(1) as f64,
+        peak_rss_mb: peak_rss_mb(),
     })
 }

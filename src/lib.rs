@@ -22,4 +22,6 @@ pub mod render;
 pub mod scenes;
 #[cfg(feature = "scripting")]
 pub mod script;
+pub mod shell;
+pub mod sweep;
 pub mod tracking;

@@ -233,12 +233,15 @@ pub fn read(path: &std::path::Path) -> std::io::Result<Vec<u8>> {
 static CANCELLED: AtomicBool = AtomicBool::new(false);
 /// The deadline as milliseconds after [`START`]; 0 = none.
 static DEADLINE_MS: AtomicU64 = AtomicU64::new(0);
+/// The budget given to [`set_deadline`], in milliseconds, for the error message.
+static BUDGET_MS: AtomicU64 = AtomicU64::new(0);
 static START: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
 
 /// Sets a wall-time budget for the rest of the process, counted from now.
 pub fn set_deadline(budget: Duration) {
     let start = *START.get_or_init(Instant::now);
     let ms = (start.elapsed() + budget).as_millis().max(1) as u64;
+    BUDGET_MS.store(budget.as_millis() as u64, Ordering::Relaxed);
     DEADLINE_MS.store(ms, Ordering::Relaxed);
 }
 
@@ -259,8 +262,8 @@ pub fn check_cancelled() -> Result<(), String> {
         let start = *START.get_or_init(Instant::now);
         if start.elapsed().as_millis() as u64 >= d {
             return Err(format!(
-                "the run passed its time limit (--max-seconds {:.0})",
-                d as f64 / 1e3
+                "the run passed its time limit (--max-seconds {})",
+                BUDGET_MS.load(Ordering::Relaxed) as f64 / 1e3
             ));
         }
     }

@@ -10,6 +10,8 @@ use clap::{Args, Parser, Subcommand};
 
 #[path = "cli/run_limits.rs"]
 mod run_limits;
+#[path = "cli/sweep_cmd.rs"]
+mod sweep_cmd;
 
 #[global_allocator]
 static ALLOCATOR: run_limits::CountingAlloc = run_limits::CountingAlloc;
@@ -88,6 +90,11 @@ enum Command {
         #[arg(long, default_value_t = 50)]
         frames: u32,
     },
+    /// Sweeps: many runs of one script from a manifest, here or on Slurm (docs/sweeps.md).
+    Sweep {
+        #[command(subcommand)]
+        command: sweep_cmd::SweepCommand,
+    },
 }
 
 /// The sandbox flags of `run` and `repl` (docs/scripting.md, "Sandbox").
@@ -161,6 +168,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 }
             }
         }
+        Some(Command::Sweep { command }) => return sweep_cmd::sweep_command(command),
         Some(cmd) => return scripting(cmd),
     }
     Ok(ExitCode::SUCCESS)
@@ -231,7 +239,7 @@ fn scripting(cmd: Command) -> anyhow::Result<ExitCode> {
                 println!("{}", p.display());
             }
         }
-        Command::Bench { .. } => unreachable!("handled in run"),
+        Command::Bench { .. } | Command::Sweep { .. } => unreachable!("handled in run"),
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -59,6 +59,38 @@ pub fn hang_self(n: usize) -> Result<Simulation, ClothError> {
     Ok(sim)
 }
 
+/// The benchmark's garment scene: the FreeSewing A-shirt (`scripts/patterns/aaron.garment.json`)
+/// meshed at `edge_mm` millimetre edges, pre-positioned around the MakeHuman mannequin (from
+/// [`crate::geometry::files::data_dir`]) and ready to sew and drape, with the dress defaults
+/// (default fabric, self-collision on). A missing mannequin is an error naming the folder.
+pub fn garment(edge_mm: usize) -> Result<Simulation, ClothError> {
+    let err = |what: &str, e: &dyn std::fmt::Display| {
+        ClothError::Parameter(format!("bench garment scene: {what}: {e}"))
+    };
+    if !(2..=100).contains(&edge_mm) {
+        return Err(ClothError::Parameter(format!(
+            "bench garment scene: edge {edge_mm} mm is outside 2–100 mm"
+        )));
+    }
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/patterns/aaron.garment.json");
+    let pattern =
+        crate::garment::read_garment(&file).map_err(|e| err(&file.display().to_string(), &e))?;
+    let dir = crate::geometry::files::data_dir().join("bodies/makehuman");
+    let man = crate::body::Mannequin::load_makehuman(&dir)
+        .map_err(|e| err(&dir.display().to_string(), &e))?;
+    let mut params = crate::garment::DressParameters::default();
+    params.mesh.edge_length = edge_mm as f64 * 1e-3;
+    let d = crate::garment::dress(
+        &pattern,
+        FabricParameters::default(),
+        &man,
+        &params,
+        SimulationParameters::default(),
+    )
+    .map_err(|e| err("dress", &e))?;
+    Ok(d.simulation)
+}
+
 /// The demo scene: a 1 m × 1 m cloth of 48 × 48 particles (default fabric) hanging from the two
 /// corners of its y = +0.5 edge above a floor at z = −1.2, simulated 2 s at dt = 1/120 s with the
 /// implicit integrator. Writes `demo.png` (800 × 600, framed on the final shape), `demo.obj`,

@@ -112,7 +112,7 @@ fn eval_script_prints_the_summary_line_and_writes_its_tables() {
     let csv = std::fs::read_to_string(out.join("facades.csv")).unwrap();
     assert_eq!(csv.lines().count(), 24);
     // the grammar pipeline on the held-out half (parameters were chosen on the other half)
-    let o = run(&["half=test"]);
+    let o = run(&["method=grammar", "half=test"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let stdout = String::from_utf8_lossy(&o.stdout);
     eprintln!("{stdout}");

@@ -92,6 +92,7 @@ fn seeds_are_read_as_their_readers_expect() {
         ("pattern", "two_pieces_seam.json"),
         ("fabric", "params_only.json"),
         ("bvh", "two_joints.bvh"),
+        ("c3d", "two_points.c3d"),
         ("pts", "sixty_eight.pts"),
         ("facade", "small_house.cga"),
         ("image", "rgb.png"),

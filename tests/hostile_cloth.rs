@@ -181,11 +181,26 @@ fn cloth_cone_of_1e5_by_1e5_is_refused_before_allocating() {
 
 #[test]
 fn cloth_patch_of_1000_m_at_1_mm_does_not_hang() {
-    // 10⁶ m² / (10⁻⁶ m² · √3/2) ≈ 1.15e12 vertices
+    // 10⁶ m² / (10⁻⁶ m² · √3/2) ≈ 1.15e12 vertices; the piece's size is refused first
     let e = case_error("cloth_patch_1000m", &[]);
     assert_has(
         &e,
-        &["estimated vertex count", "is 1.1547", "max_particles"],
+        &[
+            "spans 1000.000 m × 1000.000 m",
+            "largest accepted piece size of 10 m",
+        ],
+    );
+}
+
+#[test]
+fn cloth_patch_strip_of_100_km_within_the_particle_limit_is_refused_before_meshing() {
+    let e = case_error("cloth_patch_100km_strip", &[]);
+    assert_has(
+        &e,
+        &[
+            "rectangle 1.284 m × 100000 m",
+            "not a finite number within ±1000 m",
+        ],
     );
 }
 

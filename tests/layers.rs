@@ -561,11 +561,13 @@ const LAYERS: &[&[&str]] = &[
     &["geometry"],
     &["render"],
     &["body"],
-    &["cloth"],
+    &["cloth", "shell"],
     &["contact"],
     &["garment", "kes"],
     &["tracking", "face", "facade"],
     &["scenes", "bench"],
+    // sweeps start `emilion run` as child processes; they do not link the scripting layer
+    &["sweep"],
     &["script"],
     // the binary's own modules (src/cli/, used by src/main.rs)
     &["cli"],

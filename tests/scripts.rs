@@ -99,7 +99,8 @@ fn other_scripts_run() {
         // the contact scripts run in tests/contact_scripts.rs, the garments in
         // tests/garment_scripts.rs, the buckle_* scripts in tests/buckling.rs and the tracking
         // scripts in tests/tracking_track.rs, the face scripts in tests/face_track.rs and tests/face_fit.rs,
-        // with their checks
+        // with their checks; facade_train (minutes on its defaults) in tests/facade_learned.rs
+        // on a few photos
         if [
             "hang",
             "drop",
@@ -117,10 +118,12 @@ fn other_scripts_run() {
             "buckle_sleeve",
             "make_sequence",
             "track_body",
+            "golf_markers",
             "make_face_sequence",
             "face_track",
             "face_fit",
             "face_fit_steps",
+            "facade_train",
         ]
         .contains(&name.as_str())
         {

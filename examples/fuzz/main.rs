@@ -47,6 +47,7 @@ struct Options {
     image_seeds: Option<PathBuf>,
     worker: bool,
     save_max: usize,
+    print: bool,
 }
 
 fn usage() -> ! {
@@ -54,6 +55,7 @@ fn usage() -> ! {
         "usage: fuzz --reader NAME|all [--cases N] [--seed S] [--start I] [--seconds T]\n\
          \x20           [--timeout-s 10] [--max-alloc-mb 1024] [--corpus tests/fuzz] [--save-max 3]\n\
          \x20      fuzz --reader NAME --replay FILE_OR_DIR\n\
+         \x20      fuzz --reader NAME --seed S --start I --print   (case I's input to stdout)\n\
          readers: {}",
         targets::all()
             .iter()
@@ -78,6 +80,7 @@ fn parse_options() -> Options {
         image_seeds: None,
         worker: false,
         save_max: 3,
+        print: false,
     };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -94,6 +97,7 @@ fn parse_options() -> Options {
             "--replay" => o.replay = Some(PathBuf::from(val())),
             "--save-max" => o.save_max = val().parse().unwrap_or_else(|_| usage()),
             "--worker" => o.worker = true,
+            "--print" => o.print = true,
             "--write-image-seeds" => {
                 o.image_seeds = Some(PathBuf::from(val()));
                 o.reader = "image".into();
@@ -123,7 +127,10 @@ fn main() {
         return;
     }
     let target = targets::by_name(&o.reader).unwrap_or_else(|| usage());
-    if let Some(path) = &o.replay {
+    if o.print {
+        let seeds = seeds(&o.corpus, &target);
+        let _ = std::io::stdout().write_all(&input(&o, &target, &seeds, o.start));
+    } else if let Some(path) = &o.replay {
         replay(&target, path);
     } else if o.worker {
         work(&o, &target);
@@ -285,13 +292,15 @@ fn supervise(o: &Options) {
             }
         });
         let mut current: Option<u64> = None;
+        let pid = child.id();
+        let (mut case_wall, mut case_cpu) = (Instant::now(), cpu_seconds(pid));
         loop {
             if deadline.is_some_and(|d| Instant::now() > d) {
                 let _ = child.kill();
                 let _ = child.wait();
                 break 'workers;
             }
-            match rx.recv_timeout(Duration::from_secs_f64(o.timeout_s)) {
+            match rx.recv_timeout(Duration::from_secs_f64(o.timeout_s.min(1.0))) {
                 Ok(Event::Line(line)) => {
                     let mut w = line.splitn(4, ' ');
                     match (w.next(), w.next(), w.next()) {
@@ -300,6 +309,7 @@ fn supervise(o: &Options) {
                                 done += 1;
                             }
                             current = i.parse().ok();
+                            (case_wall, case_cpu) = (Instant::now(), cpu_seconds(pid));
                         }
                         (Some("@@"), Some("p"), Some(i)) => {
                             let i: u64 = i.parse().unwrap_or(0);
@@ -346,10 +356,21 @@ fn supervise(o: &Options) {
                     continue 'workers;
                 }
                 Err(mpsc::RecvTimeoutError::Timeout) => {
+                    // A hang is a case that spends `timeout_s` of the worker's CPU time (or
+                    // HANG_WALL_FACTOR times that in wall time): on a loaded machine a case
+                    // waiting for a core is not hanging.
+                    let cpu = cpu_seconds(pid) - case_cpu;
+                    let wall = case_wall.elapsed().as_secs_f64();
+                    if cpu < o.timeout_s && wall < HANG_WALL_FACTOR * o.timeout_s {
+                        continue;
+                    }
                     let _ = child.kill();
                     let _ = child.wait();
                     let i = current.unwrap_or(next);
-                    let why = format!("no answer within {} s", o.timeout_s);
+                    let why = format!(
+                        "no answer after {cpu:.0} s of CPU time ({wall:.0} s wall; limit {} s of CPU)",
+                        o.timeout_s
+                    );
                     record(o, &target, &seeds, &mut findings, i, "hang", &why);
                     done += 1;
                     next = i + 1;
@@ -375,6 +396,27 @@ fn supervise(o: &Options) {
     for (sig, (n, files)) in sigs {
         eprintln!("  {n:>6} × {sig}\n         saved: {}", files.join(", "));
     }
+}
+
+/// Wall time, as a multiple of the CPU-time limit, after which a case is a hang however little
+/// CPU it got (a worker blocked for ever).
+const HANG_WALL_FACTOR: f64 = 6.0;
+
+/// CPU seconds (user + system) that process `pid` has used, from `/proc/PID/stat`; 0 where that
+/// cannot be read (then only the wall-time bound applies).
+fn cpu_seconds(pid: u32) -> f64 {
+    const TICKS_PER_SECOND: f64 = 100.0; // Linux's USER_HZ on every common platform
+    let Ok(stat) = std::fs::read_to_string(format!("/proc/{pid}/stat")) else {
+        return 0.0;
+    };
+    // the fields after the command name (which may hold spaces) in parentheses
+    let Some(rest) = stat.rsplit_once(')').map(|(_, r)| r) else {
+        return 0.0;
+    };
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    // utime and stime are fields 14 and 15 of the line, 12 and 13 after the name
+    let ticks = |k: usize| f.get(k).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
+    (ticks(11) + ticks(12)) / TICKS_PER_SECOND
 }
 
 fn progress(target: &Target, done: u64, started: Instant, f: &Findings) {

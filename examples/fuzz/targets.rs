@@ -206,6 +206,26 @@ pub fn all() -> Vec<Target> {
             run: bvh,
         },
         Target {
+            name: "c3d",
+            ext: "c3d",
+            text: false,
+            dictionary: &[
+                "POINT",
+                "USED",
+                "SCALE",
+                "RATE",
+                "LABELS",
+                "UNITS",
+                "Y_SCREEN",
+                "\u{50}",
+                "T",
+                "mm",
+                "\u{ff}\u{ff}",
+                "\u{0}\u{0}",
+            ],
+            run: c3d,
+        },
+        Target {
             name: "pts",
             ext: "pts",
             text: true,
@@ -347,6 +367,16 @@ fn bvh(data: &[u8]) -> Result<(), String> {
     Ok(())
 }
 
+fn c3d(data: &[u8]) -> Result<(), String> {
+    let trial = emilion::body::markers::parse_c3d(data, "fuzz.c3d").map_err(|e| e.to_string())?;
+    let _ = trial.invalid_count();
+    let _ = trial.infer_up();
+    if trial.frames > 0 && trial.markers() > 0 {
+        let _ = trial.world(trial.frames - 1, trial.markers() - 1);
+    }
+    Ok(())
+}
+
 fn pts(data: &[u8]) -> Result<(), String> {
     emilion::face::landmarks::parse_pts(&text(data), Path::new("fuzz.pts"))
         .map(|_| ())
@@ -375,8 +405,18 @@ thread_local! {
     };
 }
 
-/// A script: run with `out` set to a scratch folder (every generated script writes there).
+/// A script: run with `out` set to a scratch folder (every generated script writes there), under
+/// a 1 s time budget as `emilion run --max-seconds 1` gives it: a legitimately long run (say
+/// `s.run(1e5)` on a small cloth, 10⁷ steps) must stop at its budget with an error, not hang.
+///
+/// It runs under `--limit max_particles=500000` too: the default 4 000 000 particles lets a script
+/// mesh or build a cloth that needs more than the harness's 1 GB cap (case 160194 of seed 1:
+/// `cloth_patch(1.2, 1.21, 0.001)`, 1.7e6 vertices, a 563 MB buffer on top of the mesher's).
 fn script(data: &[u8]) -> Result<(), String> {
+    emilion::limits::set_deadline(std::time::Duration::from_secs(1));
+    let mut limits = emilion::limits::get();
+    limits.max_particles = 500_000;
+    emilion::limits::set(limits);
     let out = std::env::temp_dir().join(format!("emilion-fuzz-{}", std::process::id()));
     let _ = std::fs::create_dir_all(&out);
     let mut scope = rhai::Scope::new();

@@ -31,6 +31,8 @@
 
 pub mod bvh;
 pub mod error;
+pub mod grading;
+pub mod markers;
 pub mod retarget;
 pub mod skeleton;
 pub mod skinning;
@@ -39,6 +41,7 @@ use std::path::Path;
 
 pub use bvh::{bvh_to_world, Motion};
 pub use error::BodyError;
+pub use markers::{read_c3d, MarkerTrial};
 pub use retarget::{Animation, RetargetOptions};
 pub use skeleton::{Bone, Joint, Skeleton};
 pub use skinning::{Pose, SkinWeights};

@@ -189,6 +189,17 @@ impl Skeleton {
         self.joint_index.get(name).map(|&k| &self.joints[k])
     }
 
+    /// Moves every bone end and joint by `f` (a grading's scale).
+    pub(crate) fn map_points(&mut self, f: impl Fn(Vec3) -> Vec3) {
+        for b in &mut self.bones {
+            b.head = f(b.head);
+            b.tail = f(b.tail);
+        }
+        for j in &mut self.joints {
+            j.rest = f(j.rest);
+        }
+    }
+
     /// Moves every rest position by `delta` (used to put the feet on the floor).
     pub(crate) fn translate(&mut self, delta: Vec3) {
         for b in &mut self.bones {

@@ -174,6 +174,11 @@ impl Simulation {
             .unwrap_or(1)
     }
 
+    /// Bytes held by the implicit system's matrix (pattern, blocks, single-precision mirrors).
+    pub fn system_matrix_bytes(&self) -> usize {
+        self.asm.a.bytes()
+    }
+
     /// Number of particles.
     pub fn particle_count(&self) -> usize {
         self.model.particle_count()

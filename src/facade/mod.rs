@@ -23,6 +23,7 @@ pub mod grammar;
 pub mod homography;
 pub mod instances;
 pub mod labels;
+pub mod learned;
 pub mod mutual_information;
 pub mod outputs;
 pub mod overlay;

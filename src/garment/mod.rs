@@ -7,6 +7,7 @@ pub mod dress;
 pub mod error;
 pub mod expand;
 pub mod formats;
+pub mod grading;
 pub mod mesh;
 pub mod outline;
 pub mod pattern;

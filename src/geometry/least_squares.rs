@@ -355,6 +355,55 @@ impl<S: Clone> LeastSquares for ForwardDifferences<'_, S> {
     }
 }
 
+/// Forward-difference Jacobian columns over a parameter vector with upper bounds, for problems
+/// that evaluate their residuals themselves: parameter `k` moves by `1e-6`, or by `−1e-6` where
+/// that would pass its upper bound, and the column is `(r(p + h e_k) − r(p)) / h`. Holds the
+/// scratch (the moved vector, its residuals, the column) so a Jacobian allocates once.
+pub struct BoundedDifferences {
+    moved: Vec<f64>,
+    moved_residuals: DVector<f64>,
+    column: DVector<f64>,
+}
+
+impl BoundedDifferences {
+    /// The difference step (before the sign for the upper bound).
+    pub const STEP: f64 = 1e-6;
+
+    /// Scratch for `rows` residuals.
+    pub fn new(rows: usize) -> BoundedDifferences {
+        BoundedDifferences {
+            moved: Vec::new(),
+            moved_residuals: DVector::zeros(rows),
+            column: DVector::zeros(rows),
+        }
+    }
+
+    /// The column of parameter `k` of `p` (upper bound `hi`), `r` being the residuals at `p` and
+    /// `residuals` the problem's residual function.
+    pub fn column(
+        &mut self,
+        p: &[f64],
+        k: usize,
+        hi: f64,
+        r: &DVector<f64>,
+        mut residuals: impl FnMut(&Vec<f64>, &mut DVector<f64>),
+    ) -> &DVector<f64> {
+        self.moved.clear();
+        self.moved.extend_from_slice(p);
+        let h = if p[k] + Self::STEP > hi {
+            -Self::STEP
+        } else {
+            Self::STEP
+        };
+        self.moved[k] += h;
+        residuals(&self.moved, &mut self.moved_residuals);
+        self.column.copy_from(&self.moved_residuals);
+        self.column -= r;
+        self.column /= h;
+        &self.column
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

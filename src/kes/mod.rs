@@ -8,6 +8,7 @@ pub mod compression;
 pub mod damping;
 pub mod error;
 pub mod fabric;
+pub mod feng;
 pub mod fit;
 pub mod kes_param;
 pub mod lab;

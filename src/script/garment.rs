@@ -94,8 +94,19 @@ fn dress_on_mannequin(
     if let Some(l) = m.remove("relax_levels") {
         params.preposition.levels = count(&l, "relax_levels")?;
     }
+    let mut grade = [1.0, 1.0];
+    for (k, key) in ["body_girth", "body_height"].into_iter().enumerate() {
+        if let Some(v) = m.remove(key) {
+            grade[k] = num(&v, key)?;
+        }
+    }
     let params: DressParameters = update_from_map(&params, &m, "dress")?;
-    let man = Mannequin::load_makehuman(&dir).map_err(|e| rt_err(e.to_string()))?;
+    let mut man = Mannequin::load_makehuman(&dir).map_err(|e| rt_err(e.to_string()))?;
+    if grade != [1.0, 1.0] {
+        man = man
+            .graded(grade[0], grade[1])
+            .map_err(|e| rt_err(e.to_string()))?;
+    }
     let mut d = dress(pattern, fabric, &man, &params, sp).map_err(perr)?;
     if let Some(law) = law {
         d.simulation.set_material(law)?;
@@ -128,7 +139,7 @@ pub fn register(engine: &mut ApiBuilder) {
         |p: &mut PatternHandle| -> INT { p.0.seams.len() as INT }
     );
     function!(engine, "garment::dress", alias = "dress", ["pattern: Pattern", "fabric: Fabric", "options: Map", "Simulation"],
-        "Meshes the pattern, pre-positions it around the MakeHuman mannequin at rest (no arrangement\npoints) and returns a simulation that sews it (seam threads shorten at `sewing_speed`, no\ngravity) and then drapes it, the mannequin as a collision body. Options: `makehuman` (dir,\ndefault `$EMILION_DATA/bodies/makehuman`), `dt` (s), and the `DressParameters` fields:\n`seam_stiffness` (N/m), `seam_max_force` (N), `sewing_speed` (m/s), `silhouette_cell` (m),\n`edge_length` (m, the mesh's target edge), `clearance` (m, kept from the skin) and\n`relax_levels` (levels of the pre-positioning's multi-resolution relaxation, 1 to 6, default 3).",
+        "Meshes the pattern, pre-positions it around the MakeHuman mannequin at rest (no arrangement\npoints) and returns a simulation that sews it (seam threads shorten at `sewing_speed`, no\ngravity) and then drapes it, the mannequin as a collision body. Options: `makehuman` (dir,\ndefault `$EMILION_DATA/bodies/makehuman`), `dt` (s), and the `DressParameters` fields:\n`seam_stiffness` (N/m), `seam_max_force` (N), `sewing_speed` (m/s), `silhouette_cell` (m),\n`edge_length` (m, the mesh's target edge), `clearance` (m, kept from the skin) and\n`relax_levels` (levels of the pre-positioning's multi-resolution relaxation, 1 to 6, default 3);\n`body_girth` and `body_height` grade the mannequin to a size (factors across and up, default 1,\n0.5 to 2: `body::Mannequin::graded`), to match a pattern graded with `graded`.",
         |p: &mut PatternHandle, f: Fabric, m: Map| -> RResult<SimHandle> {
             dress_on_mannequin(&p.0, f.0, None, m)
         });
@@ -137,6 +148,11 @@ pub fn register(engine: &mut ApiBuilder) {
         |p: &mut PatternHandle, f: KesFabric, m: Map| -> RResult<SimHandle> {
             let (params, law) = measured_fabric(&f.0).map_err(rt_err)?;
             dress_on_mannequin(&p.0, params, Some(Arc::new(law)), m)
+        });
+    register!(engine, "graded", ["pattern: Pattern", "girth: float", "height: float", "Pattern"],
+        "The pattern graded to another size: every piece scaled by `girth` across and `height` along\n(corners, curves, grain, notches, placement offsets; seam allowances kept), factors 0.5 to 2,\nthen validated (a seam that no longer matches is named). Dress it on a mannequin graded the\nsame way: `dress(p, fabric, #{ body_girth: girth, body_height: height })`.",
+        |p: &mut PatternHandle, girth: f64, height: f64| -> RResult<PatternHandle> {
+            Ok(PatternHandle(Arc::new(p.0.graded(girth, height).map_err(perr)?)))
         });
     register!(engine, "save_sheet", ["pattern: Pattern", "path: String", "()"],
         "Writes the pattern sheet (`.png` or `.svg`): the pieces side by side at 400 pixels per metre,\nnames, grain lines, notches, and each seam's two edges in its colour with its number.",

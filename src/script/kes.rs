@@ -15,7 +15,7 @@ use crate::kes::calibrate::Tests;
 use crate::kes::damping::{fit_stretch_damping, free_oscillation, DecayExperiment};
 use crate::kes::lab::{self, FabricReport, LabOptions};
 use crate::kes::rig::RigMesh;
-use crate::kes::{read_fabric, read_fabric_dir, wang, FabricSpec};
+use crate::kes::{feng, read_fabric, read_fabric_dir, wang, FabricSpec};
 
 /// A fabric read from a fabric file (KES parameters and/or curves).
 #[derive(Debug, Clone)]
@@ -229,6 +229,31 @@ pub fn register(engine: &mut ApiBuilder) {
             m.insert("worst_curve_rms_pct".into(), rs.iter().map(|r| r.worst_curve()).fold(0.0, f64::max).into());
             m.insert("worst_param_err_pct".into(), rs.iter().map(|r| r.worst_param()).fold(0.0, f64::max).into());
             m.insert("fabrics".into(), (rs.len() as rhai::INT).into());
+            Ok(m)
+        });
+    function!(engine, "kes::feng_count", alias = "feng_count", ["path: String", "int"],
+        "The number of fabrics in a Feng 2022 bending CSV (`data_dir() +\n\"/fabrics/feng2022_bending.csv\"`).",
+        |path: &str| -> RResult<rhai::INT> {
+            Ok(feng::read_feng(&read_path(path)?).map_err(rt_err)?.len() as rhai::INT)
+        });
+    function!(engine, "kes::feng_bending", alias = "feng_bending", ["path: String", "row: int", "Map"],
+        "Runs the virtual bending rig (coarse mesh, warp and weft) on the fabric of data row `row`\n(0-based) of a Feng 2022 bending CSV, its measured curve M = k1 κ + k2 κ² as the law, and\nfits k1, k2 to the rig's reading: #{row, density, k1_warp, k1_warp_fit, k2_warp,\nk2_warp_fit, (same for weft), kappa_max_warp, kappa_max_weft, curve_rms_pct_warp,\ncurve_rms_pct_weft, unconverged} (SI: N·m, N·m², 1/m).",
+        |path: &str, row: rhai::INT| -> RResult<Map> {
+            let row = usize::try_from(row).map_err(|_| rt_err(format!("feng_bending: row {row} is negative")))?;
+            let f = feng::read_feng_row(&read_path(path)?, row).map_err(rt_err)?;
+            let c = feng::compare(&f, RigMesh::COARSE).map_err(rt_err)?;
+            let mut m = Map::new();
+            m.insert("row".into(), (row as rhai::INT).into());
+            m.insert("density".into(), f.density.into());
+            for (d, dir) in ["warp", "weft"].iter().enumerate() {
+                m.insert(format!("k1_{dir}").into(), f.k1[d].into());
+                m.insert(format!("k1_{dir}_fit").into(), c.k1_fit[d].into());
+                m.insert(format!("k2_{dir}").into(), f.k2[d].into());
+                m.insert(format!("k2_{dir}_fit").into(), c.k2_fit[d].into());
+                m.insert(format!("kappa_max_{dir}").into(), f.kappa_max(d).into());
+                m.insert(format!("curve_rms_pct_{dir}").into(), c.curve_rms_pct[d].into());
+            }
+            m.insert("unconverged".into(), (c.unconverged as rhai::INT).into());
             Ok(m)
         });
     function!(engine, "kes::free_oscillation", alias = "free_oscillation", ["fabric: Fabric", "Map"],

@@ -15,6 +15,7 @@
 //! - [`output`]: positions, bounds, energies, OBJ/glTF/CSV/JSON/PNG output;
 //! - [`kes`]: the virtual Kawabata lab (fabric files, rigs, fitting, summaries);
 //! - [`facade`], [`facade_analysis`]: facade label maps, scores and the photo pipeline;
+//! - [`facade_learned`]: the learned facade classifier (training, evaluation);
 //! - [`tracking_sequence`], [`tracking`]: synthetic multi-camera sequences and the body tracker;
 //! - [`paths`]: where a script's relative paths lead (its own folder), `script_dir()`,
 //!   `data_dir()`, `out_dir()`; [`sandbox`]: what a script may read and write; [`imports`]:
@@ -31,8 +32,10 @@ pub mod docs;
 pub mod fabric;
 pub mod facade;
 pub mod facade_analysis;
+pub mod facade_learned;
 pub mod face;
 pub mod garment;
+pub mod golf;
 pub mod imports;
 pub mod kes;
 pub mod measure;
@@ -42,6 +45,7 @@ pub mod paths;
 pub mod repl;
 pub mod run;
 pub mod sandbox;
+pub mod shell;
 pub mod sim;
 pub mod sim_run;
 pub mod tracking;
@@ -180,10 +184,13 @@ pub fn build_engine_with(limits: EngineLimits) -> Engine {
     measure::register(&mut engine);
     facade::register(&mut engine);
     facade_analysis::register(&mut engine);
+    facade_learned::register(&mut engine);
     tracking::register(&mut engine);
+    golf::register(&mut engine);
     face::register(&mut engine);
     tracking_sequence::register(&mut engine);
     kes::register(&mut engine);
+    shell::register(&mut engine);
     paths::register(&mut engine);
     engine.finish()
 }

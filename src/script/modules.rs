@@ -14,7 +14,7 @@ use std::ops::{Deref, DerefMut};
 use rhai::{Engine, Module};
 
 /// The static modules, each with its doc line, in the order the reference lists them.
-pub const MODULES: [(&str, &str); 7] = [
+pub const MODULES: [(&str, &str); 8] = [
     (
         "cloth",
         "Fabrics, cloth models and the simulations that move them.",
@@ -40,6 +40,10 @@ pub const MODULES: [(&str, &str); 7] = [
         "The body tracker and the synthetic multi-camera sequences it is tested on.",
     ),
     ("plot", "Plots of series collected by a script."),
+    (
+        "shell",
+        "The meshless Kirchhoff–Love shell (Galerkin on moving least squares) and its benchmarks.",
+    ),
 ];
 
 /// The start of every alias's doc comment, followed by the function's `module::name`.

@@ -94,7 +94,7 @@ impl ScriptContext {
 }
 
 /// The working directory, absolute (`.` if it cannot be read).
-fn working_dir() -> PathBuf {
+pub(crate) fn working_dir() -> PathBuf {
     std::env::current_dir().unwrap_or_else(|_| ".".into())
 }
 

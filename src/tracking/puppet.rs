@@ -39,6 +39,7 @@ mod fit;
 #[path = "puppet_rest.rs"]
 mod rest;
 
+pub(crate) use fit::kabsch;
 pub use rest::Proportions;
 use rest::{right_of, Segment, KEYS};
 
@@ -414,6 +415,36 @@ impl Puppet {
     /// Missing or non-finite parameters count as 0; limits are not applied (see
     /// [`Puppet::clamp`]).
     pub fn pose_into(&self, params: &[f64], pose: &mut Pose) {
+        self.pose_bones(params, pose, 0..self.heads.len());
+    }
+
+    /// The bones of `bones` with all their ancestors, ascending (parents first): the set
+    /// [`Puppet::pose_subset_into`] needs to place `bones`.
+    pub fn with_ancestors(&self, bones: &[usize]) -> Vec<usize> {
+        let n = self.heads.len();
+        let mut keep = vec![false; n];
+        for &b in bones.iter().filter(|&&b| b < n) {
+            let mut c = Some(b);
+            while let Some(k) = c {
+                if keep[k] {
+                    break;
+                }
+                keep[k] = true;
+                c = self.base.parents[k];
+            }
+        }
+        (0..n).filter(|&b| keep[b]).collect()
+    }
+
+    /// [`Puppet::pose_into`] for the bones of `subset` only (ascending and closed under
+    /// parents, as [`Puppet::with_ancestors`] gives); the other transforms are left as they
+    /// were. For inverse kinematics that reads a few bones.
+    pub fn pose_subset_into(&self, params: &[f64], pose: &mut Pose, subset: &[usize]) {
+        self.pose_bones(params, pose, subset.iter().copied());
+    }
+
+    /// Forward kinematics over `bones` (parents before children).
+    fn pose_bones(&self, params: &[f64], pose: &mut Pose, bones: impl Iterator<Item = usize>) {
         let n = self.heads.len();
         if pose.len() != n {
             *pose = Pose::identity(n);
@@ -424,7 +455,7 @@ impl Puppet {
         let r_root = UnitQuaternion::from_scaled_axis(vec(3));
         let r_chest = r_root * local(0);
         let r_head = r_chest * local(1);
-        for b in 0..n {
+        for b in bones.filter(|&b| b < n) {
             let h = self.heads[b];
             let (head, r) = match (self.drives[b], self.base.parents[b]) {
                 (Drive::Root, _) | (_, None) => (h + vec(0), r_root),

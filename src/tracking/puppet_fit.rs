@@ -7,7 +7,7 @@ use nalgebra::{DMatrix, DVector, Matrix3, UnitQuaternion};
 use super::{Puppet, PARAM_COUNT};
 use crate::body::Pose;
 use crate::geometry::least_squares::{
-    self, DampingUpdate, DiagonalDamping, LeastSquares, Schedule, Tries,
+    self, BoundedDifferences, DampingUpdate, DiagonalDamping, LeastSquares, Schedule, Tries,
 };
 use crate::geometry::Vec3;
 use crate::tracking::joints::JOINT_COUNT;
@@ -20,7 +20,7 @@ const TRUNK: [usize; 7] = [0, 1, 2, 4, 7, 10, 13];
 const PRIOR: f64 = 0.01;
 
 /// Best rigid motion `x ↦ r x + t` taking the first points onto the second (Kabsch).
-fn kabsch(pairs: &[(Vec3, Vec3)]) -> Option<(UnitQuaternion<f64>, Vec3)> {
+pub(crate) fn kabsch(pairs: &[(Vec3, Vec3)]) -> Option<(UnitQuaternion<f64>, Vec3)> {
     let n = pairs.len() as f64;
     let ca = pairs.iter().map(|p| p.0).sum::<Vec3>() / n;
     let cb = pairs.iter().map(|p| p.1).sum::<Vec3>() / n;
@@ -199,18 +199,14 @@ impl LeastSquares for JointFit<'_> {
     }
 
     fn jacobian(&mut self, p: &Vec<f64>, r: &DVector<f64>, jac: &mut DMatrix<f64>) {
-        let mut q = p.clone();
-        let mut r2 = DVector::zeros(self.rows);
-        for (c, &i) in self.active.iter().enumerate() {
-            q.copy_from_slice(p);
-            let h = if p[i] + 1e-6 > self.puppet.params[i].hi {
-                -1e-6
-            } else {
-                1e-6
-            };
-            q[i] += h;
-            self.residuals(&q, &mut r2);
-            jac.set_column(c, &((&r2 - r) / h));
+        let mut differences = BoundedDifferences::new(self.rows);
+        for c in 0..self.active.len() {
+            let i = self.active[c];
+            let hi = self.puppet.params[i].hi;
+            jac.set_column(
+                c,
+                differences.column(p, i, hi, r, |q, out| self.residuals(q, out)),
+            );
         }
     }
 

@@ -432,6 +432,27 @@ impl Bcsr3 {
         self.diag.len()
     }
 
+    /// Bytes held by the matrix: pattern, double-precision blocks (general or symmetric) and
+    /// the single-precision mirrors.
+    pub fn bytes(&self) -> usize {
+        use std::mem::size_of;
+        let mut b = self.row_ptr.len() * size_of::<usize>()
+            + self.cols.len() * size_of::<u32>()
+            + self.values.len() * size_of::<Mat3>()
+            + self.sym.len() * size_of::<Sym3>()
+            + self.diag.len() * size_of::<usize>()
+            + self.values32.len() * size_of::<Sym3f>()
+            + self.stencil32.len() * size_of::<i32>();
+        if let Some(p) = &self.permuted {
+            b += p.order.len() * size_of::<u32>()
+                + (p.start.len() + p.row_start.len() + p.diag.len()) * size_of::<usize>()
+                + p.cols.len() * size_of::<u32>()
+                + p.values.len() * size_of::<Sym3f>()
+                + p.stencil.len() * size_of::<i32>();
+        }
+        b
+    }
+
     /// Number of stored blocks.
     pub fn nnz_blocks(&self) -> usize {
         self.cols.len()

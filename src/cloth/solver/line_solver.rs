@@ -241,6 +241,11 @@ impl LineSolver {
         transpose(e, &mut self.e_weft, nx, ny);
     }
 
+    /// Copies the per-particle field `src` (row numbering) into `dst` in the weft numbering.
+    pub fn to_weft<T: Copy + Send + Sync>(&self, src: &[T], dst: &mut [T]) {
+        transpose(src, dst, self.nx, self.ny);
+    }
+
     /// Copies the weft-numbered correction back into `e` (row numbering).
     pub fn leave_weft(&self, e: &mut [Vec3]) {
         transpose(&self.e_weft, e, self.ny, self.nx);

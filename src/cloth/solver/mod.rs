@@ -8,6 +8,7 @@ pub mod amg;
 pub mod assembly;
 pub mod bcsr;
 pub(crate) mod contribution;
+pub mod galerkin;
 pub mod line_solver;
 pub mod multigrid;
 pub mod parallel;

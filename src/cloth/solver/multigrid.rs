@@ -7,6 +7,8 @@
 
 use super::assembly::{Assembly, AssemblyInputs};
 use super::bcsr::{Bcsr3, Sym3f};
+pub use super::galerkin::ContactCoarsening;
+use super::galerkin::{self, FineConstraints, GalerkinTransfer};
 use super::line_solver::{weft_order, LineDir, LineSolver};
 use super::parallel::{for_each_mut, PAR_MIN};
 use super::vcycle::{self, Hierarchy};
@@ -91,24 +93,57 @@ impl Transfer {
         }
     }
 
-    /// fine += P coarse
-    fn prolong_add(&self, coarse: &[Vec3], fine: &mut [Vec3], fixed: &[bool]) {
+    /// fine += S P coarse: with constrained directions `dirs` (a unit normal or zero per fine
+    /// particle), the correction's component along each is projected out (S = I − n nᵀ), so
+    /// that the coarse correction never pushes against a contact.
+    fn prolong_add(
+        &self,
+        coarse: &[Vec3],
+        fine: &mut [Vec3],
+        fixed: &[bool],
+        dirs: Option<&[Vec3]>,
+    ) {
         let par = fine.len() >= PAR_MIN;
-        for_each_mut(fine, par, |i, f| {
-            if !fixed[i] {
-                *f += bilinear(&self.taps[i], coarse);
-            }
-        });
+        match dirs {
+            None => for_each_mut(fine, par, |i, f| {
+                if !fixed[i] {
+                    *f += bilinear(&self.taps[i], coarse);
+                }
+            }),
+            Some(dirs) => for_each_mut(fine, par, |i, f| {
+                if !fixed[i] {
+                    *f += project_out(bilinear(&self.taps[i], coarse), &dirs[i]);
+                }
+            }),
+        }
     }
 
-    /// coarse = Pᵀ fine (fixed coarse particles get zero)
-    fn restrict(&self, fine: &[Vec3], coarse: &mut [Vec3], coarse_fixed: &[bool]) {
+    /// coarse = Pᵀ S fine (fixed coarse particles get zero; `dirs` as in
+    /// [`Transfer::prolong_add`], whose adjoint this is).
+    fn restrict(
+        &self,
+        fine: &[Vec3],
+        coarse: &mut [Vec3],
+        coarse_fixed: &[bool],
+        dirs: Option<&[Vec3]>,
+    ) {
         let par = coarse.len() >= PAR_MIN;
         for_each_mut(coarse, par, |i, out| {
             *out = Vec3::zeros();
             if !coarse_fixed[i] {
-                for &(f, w) in &self.rev[self.rev_ptr[i]..self.rev_ptr[i + 1]] {
-                    *out += fine[f as usize] * w;
+                let taps = &self.rev[self.rev_ptr[i]..self.rev_ptr[i + 1]];
+                match dirs {
+                    None => {
+                        for &(f, w) in taps {
+                            *out += fine[f as usize] * w;
+                        }
+                    }
+                    Some(dirs) => {
+                        for &(f, w) in taps {
+                            let f = f as usize;
+                            *out += project_out(fine[f], &dirs[f]) * w;
+                        }
+                    }
                 }
             }
         });
@@ -122,6 +157,12 @@ fn bilinear(t: &[(u32, f64); 4], field: &[Vec3]) -> Vec3 {
         + field[t[1].0 as usize] * t[1].1
         + field[t[2].0 as usize] * t[2].1
         + field[t[3].0 as usize] * t[3].1
+}
+
+/// `v` without its component along `n` (a unit vector, or zero: `v` unchanged).
+#[inline]
+fn project_out(v: Vec3, n: &Vec3) -> Vec3 {
+    v - n * n.dot(&v)
 }
 
 /// A coarse level's state sampled from the finer level's field at the coarse rest positions.
@@ -143,12 +184,19 @@ struct Level {
     pen_dir: Vec<Vec3>,
     pen: Vec<Sym3f>,
     penalized: bool,
+    /// `pen_dir` in the weft numbering, where the transfers work.
+    dir_weft: Vec<Vec3>,
     /// Transfer from the next coarser level to this one, this level's particles in the weft
     /// numbering (where its residual is formed and its correction lives between the two
     /// weft sweeps).
     to_fine: Option<Transfer>,
     /// Sampling of this level's state from the next finer level (coarse levels only).
     sample: Vec<[(u32, f64); 4]>,
+    /// Grid size (particles per side).
+    dims: (usize, usize),
+    /// The Galerkin operator used while contacts constrain the cloth (coarse levels only;
+    /// built on the first such step).
+    gal: Option<GalerkinOp>,
     x: Vec<Vec3>,
     v: Vec<Vec3>,
     r: Vec<Vec3>,
@@ -156,10 +204,23 @@ struct Level {
     d: Vec<Vec3>,
 }
 
+/// A coarse level's Galerkin operator, its line factors and the transfer from the finer level
+/// in row numbering.
+#[derive(Debug)]
+struct GalerkinOp {
+    a: Bcsr3,
+    lines: LineSolver,
+    from_fine: GalerkinTransfer,
+}
+
 /// The multigrid hierarchy of one grid cloth.
 #[derive(Debug)]
 pub struct Multigrid {
     levels: Vec<Level>,
+    /// How contacts reach the coarse levels.
+    pub contact: ContactCoarsening,
+    /// Whether this step's coarse levels are Galerkin operators.
+    galerkin_now: bool,
     /// Accumulated wall time in `setup` and `apply` (s), and the number of applications.
     pub timing: (f64, f64, u64),
 }
@@ -192,8 +253,11 @@ impl Multigrid {
             pen_dir: vec![Vec3::zeros(); n],
             pen: vec![Sym3f::default(); n],
             penalized: false,
+            dir_weft: vec![Vec3::zeros(); n],
             to_fine: None,
             sample: Vec::new(),
+            dims: (nx, ny),
+            gal: None,
             x: Vec::new(),
             v: Vec::new(),
             r: vec![Vec3::zeros(); n],
@@ -225,8 +289,11 @@ impl Multigrid {
                 pen_dir: vec![Vec3::zeros(); nc],
                 pen: vec![Sym3f::default(); nc],
                 penalized: false,
+                dir_weft: vec![Vec3::zeros(); nc],
                 to_fine: None,
                 sample: sampling((fx, fy), (cx, cy)),
+                dims: (cx, cy),
+                gal: None,
                 x: vec![Vec3::zeros(); nc],
                 v: vec![Vec3::zeros(); nc],
                 r: vec![Vec3::zeros(); nc],
@@ -237,6 +304,8 @@ impl Multigrid {
         }
         Ok(Multigrid {
             levels,
+            contact: ContactCoarsening::from_env(),
+            galerkin_now: false,
             timing: (0.0, 0.0, 0),
         })
     }
@@ -269,6 +338,9 @@ impl Multigrid {
     /// filter's fixed particles are fixed on every level; its velocity-constrained directions
     /// (contacts) enter each level's operator as stiff penalty springs κ n nᵀ, so that the
     /// V-cycle approximates the inverse of the constrained system rather than the free one.
+    /// While any particle is in contact the coarse levels are instead Galerkin products of
+    /// the level above (with [`ContactCoarsening::Galerkin`], opt-in), which carry every
+    /// constraint down exactly.
     pub fn setup(
         &mut self,
         a: &Bcsr3,
@@ -293,9 +365,18 @@ impl Multigrid {
             }
             if l0.penalized {
                 fill_penalty(a, &l0.pen_dir, &mut l0.pen);
+                if self.contact == ContactCoarsening::Projected {
+                    l0.lines.to_weft(&l0.pen_dir, &mut l0.dir_weft);
+                }
             }
             let pen = l0.penalized.then_some(&l0.pen[..]);
             l0.lines.factor(a, &l0.fixed, pen);
+        }
+        self.galerkin_now = self.levels[0].penalized && self.contact == ContactCoarsening::Galerkin;
+        if self.galerkin_now {
+            self.setup_galerkin(a);
+            self.timing.0 += t0.elapsed().as_secs_f64();
+            return;
         }
         for l in 1..self.levels.len() {
             let (fine, coarse) = self.levels.split_at_mut(l);
@@ -323,11 +404,61 @@ impl Multigrid {
             asm.assemble(model, &c.x, &c.v, inp);
             if c.penalized {
                 fill_penalty(&asm.a, &c.pen_dir, &mut c.pen);
+                if self.contact == ContactCoarsening::Projected {
+                    c.lines.to_weft(&c.pen_dir, &mut c.dir_weft);
+                }
             }
             let pen = c.penalized.then_some(&c.pen[..]);
             c.lines.factor(&asm.a, &c.fixed, pen);
         }
         self.timing.0 += t0.elapsed().as_secs_f64();
+    }
+
+    /// The coarse levels as Galerkin products `Pᵀ Â P` of the level above (see
+    /// [`galerkin`]): the finest level's operator with its penalties and fixed particles, each
+    /// coarser one from the last. Coarse levels then have no fixed particles or penalties of
+    /// their own. Built on the first call (allocation once per topology).
+    fn setup_galerkin(&mut self, a: &Bcsr3) {
+        for l in 1..self.levels.len() {
+            let (fine, coarse) = self.levels.split_at_mut(l);
+            let f = &fine[l - 1];
+            let c = &mut coarse[0];
+            let gal = c.gal.get_or_insert_with(|| {
+                let (cx, cy) = c.dims;
+                let mut ga = galerkin::coarse_pattern(cx, cy);
+                let lines = LineSolver::new(&mut ga, cx, cy);
+                ga.store_single_only();
+                let taps = Transfer::new(f.dims, c.dims).taps;
+                GalerkinOp {
+                    a: ga,
+                    lines,
+                    from_fine: GalerkinTransfer::new(taps, c.dims),
+                }
+            });
+            let (fa, cons) = if l == 1 {
+                let pen: &[Sym3f] = if f.penalized { &f.pen } else { &[] };
+                (
+                    a,
+                    FineConstraints {
+                        pen,
+                        fixed: &f.fixed,
+                    },
+                )
+            } else {
+                let fa = &f.gal.as_ref().expect("finer Galerkin level").a;
+                (
+                    fa,
+                    FineConstraints {
+                        pen: &[],
+                        fixed: &[],
+                    },
+                )
+            };
+            galerkin::fill(fa, cons, &gal.from_fine, &mut gal.a);
+            c.fixed.fill(false);
+            c.penalized = false;
+            gal.lines.factor(&gal.a, &c.fixed, None);
+        }
     }
 
     /// Applies one V-cycle to residual `r` (finest level, matrix `a`), writing `s ≈ A⁻¹ r`.
@@ -355,34 +486,32 @@ impl Hierarchy for Multigrid {
 
     /// The coarsest level of a V-cycle: symmetric alternating line sweeps only.
     fn solve_coarsest(&mut self, l: usize, a0: &Bcsr3) {
+        let gal = self.galerkin_now && l > 0;
         let lv = &mut self.levels[l];
-        let a = operator(&lv.asm, a0);
+        let (a, lines) = operator_lines(&lv.asm, &mut lv.gal, &mut lv.lines, gal, a0);
         let pen = lv.penalized.then_some(&lv.pen[..]);
         lv.e.fill(Vec3::zeros());
         for p in 0..COARSE_SWEEPS {
             let (r, e) = (&lv.r, &mut lv.e);
-            lv.lines
-                .sweep(a, LineDir::Warp, r, e, &lv.fixed, pen, FORWARD, p == 0);
-            lv.lines
-                .sweep(a, LineDir::Weft, r, e, &lv.fixed, pen, FORWARD, false);
+            lines.sweep(a, LineDir::Warp, r, e, &lv.fixed, pen, FORWARD, p == 0);
+            lines.sweep(a, LineDir::Weft, r, e, &lv.fixed, pen, FORWARD, false);
         }
         for _ in 0..COARSE_SWEEPS {
             let (r, e) = (&lv.r, &mut lv.e);
-            lv.lines
-                .sweep(a, LineDir::Weft, r, e, &lv.fixed, pen, BACKWARD, false);
-            lv.lines
-                .sweep(a, LineDir::Warp, r, e, &lv.fixed, pen, BACKWARD, false);
+            lines.sweep(a, LineDir::Weft, r, e, &lv.fixed, pen, BACKWARD, false);
+            lines.sweep(a, LineDir::Warp, r, e, &lv.fixed, pen, BACKWARD, false);
         }
     }
 
     /// Warp lines, then weft lines, colours forward; the weft sweep, the residual and the
     /// transfers work in the weft numbering.
     fn pre_smooth(&mut self, l: usize, a0: &Bcsr3) {
+        let gal = self.galerkin_now && l > 0;
         let lv = &mut self.levels[l];
-        let a = operator(&lv.asm, a0);
+        let (a, lines) = operator_lines(&lv.asm, &mut lv.gal, &mut lv.lines, gal, a0);
         let pen = lv.penalized.then_some(&lv.pen[..]);
         lv.e.fill(Vec3::zeros());
-        lv.lines.sweep(
+        lines.sweep(
             a,
             LineDir::Warp,
             &lv.r,
@@ -392,39 +521,48 @@ impl Hierarchy for Multigrid {
             FORWARD,
             true,
         );
-        lv.lines.enter_weft(&lv.r, &lv.e);
-        lv.lines.sweep_weft(a, lv.penalized, FORWARD, false);
-        lv.lines
-            .residual_weft(a, lv.penalized, FORWARD[2], &mut lv.d);
+        lines.enter_weft(&lv.r, &lv.e);
+        lines.sweep_weft(a, lv.penalized, FORWARD, false);
+        lines.residual_weft(a, lv.penalized, FORWARD[2], &mut lv.d);
     }
 
     fn restrict(&mut self, l: usize) {
+        let projected = self.contact == ContactCoarsening::Projected;
         let (fine, coarse) = self.levels.split_at_mut(l + 1);
         let (f, c) = (&fine[l], &mut coarse[0]);
+        let dirs = (projected && f.penalized).then_some(&f.dir_weft[..]);
         f.to_fine
             .as_ref()
             .expect("transfer")
-            .restrict(&f.d, &mut c.r, &c.fixed);
+            .restrict(&f.d, &mut c.r, &c.fixed, dirs);
     }
 
     fn prolong(&mut self, l: usize) {
+        let gal = self.galerkin_now && l > 0;
+        let projected = self.contact == ContactCoarsening::Projected;
         let (fine, coarse) = self.levels.split_at_mut(l + 1);
         let (lv, c) = (&mut fine[l], &coarse[0]);
-        let (e_weft, fixed_weft) = lv.lines.weft_correction();
+        let dirs = (projected && lv.penalized).then_some(&lv.dir_weft[..]);
+        let lines = match (gal, lv.gal.as_mut()) {
+            (true, Some(g)) => &mut g.lines,
+            _ => &mut lv.lines,
+        };
+        let (e_weft, fixed_weft) = lines.weft_correction();
         lv.to_fine
             .as_ref()
             .expect("transfer")
-            .prolong_add(&c.e, e_weft, fixed_weft);
+            .prolong_add(&c.e, e_weft, fixed_weft, dirs);
     }
 
     /// Weft then warp, colours backward.
     fn post_smooth(&mut self, l: usize, a0: &Bcsr3) {
+        let gal = self.galerkin_now && l > 0;
         let lv = &mut self.levels[l];
-        let a = operator(&lv.asm, a0);
-        lv.lines.sweep_weft(a, lv.penalized, BACKWARD, false);
-        lv.lines.leave_weft(&mut lv.e);
+        let (a, lines) = operator_lines(&lv.asm, &mut lv.gal, &mut lv.lines, gal, a0);
+        lines.sweep_weft(a, lv.penalized, BACKWARD, false);
+        lines.leave_weft(&mut lv.e);
         let pen = lv.penalized.then_some(&lv.pen[..]);
-        lv.lines.sweep(
+        lines.sweep(
             a,
             LineDir::Warp,
             &lv.r,
@@ -437,9 +575,19 @@ impl Hierarchy for Multigrid {
     }
 }
 
-/// A level's matrix: its own assembly's, or the finest level's `a0`.
-fn operator<'a>(asm: &'a Option<Assembly>, a0: &'a Bcsr3) -> &'a Bcsr3 {
-    asm.as_ref().map_or(a0, |asm| &asm.a)
+/// A level's matrix and line factors: its Galerkin operator's when `gal`, otherwise its own
+/// assembly's matrix, or the finest level's `a0`, with its own line factors.
+fn operator_lines<'a>(
+    asm: &'a Option<Assembly>,
+    gal_op: &'a mut Option<GalerkinOp>,
+    lines: &'a mut LineSolver,
+    gal: bool,
+    a0: &'a Bcsr3,
+) -> (&'a Bcsr3, &'a mut LineSolver) {
+    match (gal, gal_op.as_mut()) {
+        (true, Some(g)) => (&g.a, &mut g.lines),
+        _ => (asm.as_ref().map_or(a0, |asm| &asm.a), lines),
+    }
 }
 
 const FORWARD: [usize; 3] = [0, 1, 2];

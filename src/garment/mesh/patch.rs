@@ -51,6 +51,9 @@ pub fn rectangle_mesh(width: f64, height: f64, edge_length: f64) -> Result<TriMe
         pieces: vec![piece],
         seams: Vec::new(),
     };
+    // the pattern's own checks: a piece within MAX_PIECE_SIZE (a 100 km × 1.3 m patch within
+    // the particle limit took minutes to mesh, out of reach of the run's deadline)
+    pattern.validate()?;
     let params = MeshParameters {
         edge_length,
         ..MeshParameters::default()

@@ -1,0 +1,58 @@
+//! Script bindings of the meshless Kirchhoff–Love shell: its benchmark cases (the work lives in
+//! `crate::shell::benchmarks`).
+
+use rhai::{Array, Dynamic, Map, INT};
+
+use super::convert::{rt_err, update_from_map, RResult};
+use super::{function, modules::ApiBuilder};
+use crate::shell::benchmarks::{
+    heavy_cantilever, pinched_cylinder, pinched_hemisphere, scordelis_lo, square_plate,
+    BenchmarkResult,
+};
+use crate::shell::ShellParameters;
+
+fn result_map(r: &BenchmarkResult) -> Map {
+    let mut m = Map::new();
+    m.insert("name".into(), Dynamic::from(r.name.clone()));
+    m.insert("points".into(), Dynamic::from_int(r.points as INT));
+    m.insert("value".into(), Dynamic::from_float(r.value));
+    m.insert("reference".into(), Dynamic::from_float(r.reference));
+    m.insert("error".into(), Dynamic::from_float(r.error));
+    m.insert("seconds".into(), Dynamic::from_float(r.seconds));
+    m
+}
+
+/// Registers the shell functions.
+pub fn register(engine: &mut ApiBuilder) {
+    function!(engine, "shell::benchmark", ["case: String", "points: int", "options: Map", "Map"],
+        "Runs one shell benchmark with `points` sample points along its longer side and the\nshell parameters `options` (fields of ShellParameters: basis, support_factor,\ncell_factor, gauss, penalty, ...; #{} for the defaults). `case`:\n\"plate_simply_supported\", \"plate_clamped\" (centre deflection / (q a⁴/D)), \"cantilever\"\n(tip angle, degrees, worst of q L³/B = 1 … 20), \"scordelis_lo\", \"pinched_cylinder\",\n\"pinched_hemisphere\". Returns #{name, points, value, reference, error (percent; degrees\nfor the cantilever), seconds, rows (cantilever: [q L³/B, angle, reference] per row)}.",
+        |case: &str, points: INT, options: Map| -> RResult<Map> {
+            if !(3..=200).contains(&points) {
+                return Err(rt_err(format!("shell::benchmark: `points` must lie in [3, 200], got {points}")));
+            }
+            let n = points as usize;
+            let params: ShellParameters = update_from_map(&ShellParameters::default(), &options, "shell")?;
+            let mut rows = Array::new();
+            let r = match case {
+                "plate_simply_supported" => square_plate(n, false, params),
+                "plate_clamped" => square_plate(n, true, params),
+                "scordelis_lo" => scordelis_lo(n, params),
+                "pinched_cylinder" => pinched_cylinder(n, params),
+                "pinched_hemisphere" => pinched_hemisphere(n, params),
+                "cantilever" => heavy_cantilever(n, params).map(|(table, r)| {
+                    rows = table
+                        .iter()
+                        .map(|row| Dynamic::from_array(row.iter().map(|v| Dynamic::from_float(*v)).collect()))
+                        .collect();
+                    r
+                }),
+                other => return Err(rt_err(format!(
+                    "shell::benchmark: unknown case `{other}` (plate_simply_supported, plate_clamped, cantilever, scordelis_lo, pinched_cylinder, pinched_hemisphere)"
+                ))),
+            }
+            .map_err(rt_err)?;
+            let mut m = result_map(&r);
+            m.insert("rows".into(), Dynamic::from_array(rows));
+            Ok(m)
+        });
+}

@@ -1,0 +1,34 @@
+//! The meshless Kirchhoff–Love shell: a thin shell described by its mid-surface alone
+//! (membrane and bending strains of the deformed surface, Green–Lagrange strain, large
+//! rotations), discretised without a mesh over moving-least-squares shape functions
+//! (quadratic or cubic basis, C¹ and more, which Kirchhoff–Love bending needs). The weak form
+//! is Galerkin, integrated by Gauss points on background cells that are not a mesh of the
+//! shape functions (the local Petrov–Galerkin form, MLPG1, was tried first and could not reach
+//! the plate values: `docs/shell.md`). Solved by Newton's method with load stepping and
+//! `faer`'s sparse LU, its symbolic factorisation reused across steps.
+//!
+//! Files: [`mls`] shape functions, [`neighbours`] the point grid and spacing, [`surface`] the
+//! rest surfaces, [`jet`] second-order automatic differentiation, [`kinematics`] strains and
+//! energy density, [`material`] the laws, [`problem`] problems and parameters,
+//! [`discretisation`] background cells and quadrature, [`assembly`] residual and tangent,
+//! [`solve`] Newton, [`benchmarks`] the shell obstacle course.
+
+pub mod assembly;
+pub mod benchmarks;
+pub mod discretisation;
+pub mod error;
+pub mod jet;
+pub mod kinematics;
+pub mod material;
+pub mod mls;
+pub mod neighbours;
+pub mod problem;
+pub mod solve;
+pub mod surface;
+
+pub use discretisation::Discretisation;
+pub use error::ShellError;
+pub use material::ShellMaterial;
+pub use mls::Basis;
+pub use problem::{Constraint, Direction, ShellParameters, ShellProblem};
+pub use surface::Surface;

@@ -1,0 +1,109 @@
+//! The meshless Kirchhoff–Love shell (MLPG) against analytic and published values: Timoshenko's
+//! plate coefficients, the elastica table of the heavy cantilever
+//! (`../shared/reference/elastica-table.txt`, copied into `ELASTICA_TIP_ANGLES`), the
+//! Scordelis–Lo roof; and its errors on bad input.
+
+use emilion::shell::benchmarks::{
+    heavy_cantilever, scordelis_lo, square_plate, ELASTICA_TIP_ANGLES,
+};
+use emilion::shell::{
+    problem::grid_nodes, Discretisation, ShellMaterial, ShellParameters, ShellProblem, Surface,
+};
+
+#[test]
+fn simply_supported_plate_centre_deflection_within_one_percent_of_timoshenko() {
+    let r = square_plate(15, false, ShellParameters::default()).unwrap();
+    println!("{r:?}");
+    assert!(r.error.abs() < 1.0, "{r:?}");
+}
+
+#[test]
+fn clamped_plate_centre_deflection_within_one_percent_of_timoshenko() {
+    let r = square_plate(15, true, ShellParameters::default()).unwrap();
+    println!("{r:?}");
+    assert!(r.error.abs() < 1.0, "{r:?}");
+}
+
+#[test]
+fn heavy_cantilever_tip_angles_within_one_degree_of_the_elastica() {
+    let (rows, worst) = heavy_cantilever(21, ShellParameters::default()).unwrap();
+    println!("{rows:?}\n{worst:?}");
+    assert_eq!(rows.len(), ELASTICA_TIP_ANGLES.len());
+    for r in &rows {
+        assert!(
+            (r[1] - r[2]).abs() < 1.0,
+            "q L³/B = {}: {} vs {} degrees",
+            r[0],
+            r[1],
+            r[2]
+        );
+    }
+}
+
+#[test]
+fn scordelis_lo_roof() {
+    let r = scordelis_lo(17, ShellParameters::default()).unwrap();
+    println!("{r:?}");
+    assert!(r.error.abs() < 2.0, "{r:?}");
+}
+
+fn plate_problem(nodes: Vec<[f64; 2]>) -> ShellProblem {
+    ShellProblem {
+        surface: Surface::Plane,
+        domain: [0.0, 1.0, 0.0, 1.0],
+        nodes,
+        material: ShellMaterial::isotropic(1e9, 0.3, 0.01, 1.0).unwrap(),
+        edges: Default::default(),
+        pins: vec![],
+        area_load: [0.0, 0.0, -1.0],
+        point_loads: vec![],
+    }
+}
+
+#[test]
+fn too_small_a_support_is_an_error_naming_the_point() {
+    let params = ShellParameters {
+        support_factor: 1.2,
+        ..ShellParameters::default()
+    };
+    let e = Discretisation::new(
+        plate_problem(grid_nodes([0.0, 1.0, 0.0, 1.0], 6, 6)),
+        params,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("quadrature point of cell 0, 0") && e.contains("neighbours"),
+        "{e}"
+    );
+}
+
+#[test]
+fn points_outside_the_domain_and_coincident_points_are_errors() {
+    let mut nodes = grid_nodes([0.0, 1.0, 0.0, 1.0], 5, 5);
+    nodes.push([1.5, 0.5]);
+    let e = Discretisation::new(plate_problem(nodes), ShellParameters::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("sample point 25") && e.contains("outside"),
+        "{e}"
+    );
+    let mut nodes = grid_nodes([0.0, 1.0, 0.0, 1.0], 5, 5);
+    nodes.push([0.25, 0.25]);
+    let e = Discretisation::new(plate_problem(nodes), ShellParameters::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("coincide"), "{e}");
+    let params = ShellParameters {
+        penalty: f64::NAN,
+        ..ShellParameters::default()
+    };
+    let e = Discretisation::new(
+        plate_problem(grid_nodes([0.0, 1.0, 0.0, 1.0], 5, 5)),
+        params,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("penalty"), "{e}");
+}
