@@ -13,6 +13,7 @@ use crate::body::Mannequin;
 use crate::geometry::checkpoint::Fingerprint;
 use crate::geometry::files::data_path;
 use crate::tracking::checkpoint::TrackCheckpoint;
+use crate::tracking::loss::FrameStatus;
 use crate::tracking::sequence_files::Sequence;
 use crate::tracking::sequence_run::track_sequence_from;
 use crate::tracking::track_outputs::{arm_joints, write_track_outputs, TrackOutputOptions};
@@ -59,6 +60,23 @@ fn options(m: &Map) -> RResult<(TrackerOptions, TrackOutputOptions, Option<Strin
                     .map_err(|_| rt_err("`limb_restarts` must be true or false"))?
             }
             "seed" => o.seed = count(v, "seed")? as u64,
+            "init" => {
+                o.auto_start = match v.to_string().as_str() {
+                    "auto" => true,
+                    "joints" => false,
+                    other => {
+                        return Err(rt_err(format!(
+                            "track_body: `init` is `auto` or `joints`, not `{other}`"
+                        )))
+                    }
+                }
+            }
+            "recover" => {
+                o.recover = v
+                    .as_bool()
+                    .map_err(|_| rt_err("`recover` must be true or false"))?
+            }
+            "first_frame" => o.first_frame = count(v, "first_frame")?,
             "frames" => o.frames = Some(count(v, "frames")?),
             "overlay_every" => out.overlay_every = count(v, "overlay_every")?,
             "makehuman" => makehuman = Some(v.to_string()),
@@ -66,7 +84,7 @@ fn options(m: &Map) -> RResult<(TrackerOptions, TrackOutputOptions, Option<Strin
                 return Err(rt_err(format!(
                 "track_body: unknown option `{other}` (particles, layers, passes, robust_sigma, \
                      mesh_cell, lbs, background_frames, prediction, prior_weight, limb_restarts, seed, \
-                     frames, \
+                     init, recover, first_frame, frames, \
                      overlay_every, makehuman)"
             )))
             }
@@ -81,7 +99,8 @@ fn track(seq_dir: &str, out: &str, m: &Map) -> RResult<Map> {
     let mh =
         read_folder_opt(makehuman.as_deref())?.unwrap_or_else(|| data_path("bodies/makehuman"));
     let mannequin = Mannequin::load_makehuman(&mh).map_err(rt_err)?;
-    let total = options.frames.map_or(seq.frames, |f| f.min(seq.frames));
+    let available = seq.frames.saturating_sub(options.first_frame);
+    let total = options.frames.map_or(available, |f| f.min(available));
     let bar = std::io::stderr()
         .is_terminal()
         .then(|| ProgressBar::new(total as u64));
@@ -139,6 +158,16 @@ fn track(seq_dir: &str, out: &str, m: &Map) -> RResult<Map> {
             .map(|e| e.iter().cloned().fold(0.0, f64::max))),
     );
     r.insert("arm_mm".into(), f(result.joints_error_mm(&arm_joints())));
+    let frames_with = |s| {
+        let v: rhai::Array = result
+            .frames_with(s)
+            .into_iter()
+            .map(|k| Dynamic::from_int(k as INT))
+            .collect();
+        Dynamic::from_array(v)
+    };
+    r.insert("lost".into(), frames_with(FrameStatus::Lost));
+    r.insert("recovered".into(), frames_with(FrameStatus::Recovered));
     r.insert(
         "s_per_frame".into(),
         Dynamic::from_float(result.seconds_per_frame()),
@@ -175,7 +204,8 @@ every camera, its joint angles found frame by frame by annealing. Writes under `
 tracked motion (`tracked.bvh`, `tracked_joints.csv`), the broadcast pictures
 (`overlay/NNNN.png`), swing metrics (CSV and plots), `errors.csv` and `summary.json`.
 Returns #{frames, mpjpe_mm, max_frame_mm, arm_mm (elbows and wrists; () without ground
-truth), s_per_frame, stage_seconds (per frame), start_seconds, files}.",
+truth), lost and recovered (the frames the loss detector marked), s_per_frame, stage_seconds
+(per frame), start_seconds, files}; `track_status.csv` lists every frame's state.",
         |seq: &str, out: &str| track(seq, out, &Map::new())
     );
     function!(
@@ -189,7 +219,9 @@ of each annealing layer, coarse first, e.g. [1, 1, 1, 0, 0]), `robust_sigma` (gr
 `prediction` (velocity factor), `prior_weight` (motion prior per squared move spread,
 default 0.05), `limb_restarts` (limb stages also start from the previous,
 the rest, a half-bent and a straightened limb pose; default true), `seed`, `frames` (track only the first
-frames), `passes` (spread factor of each pass of the stage hierarchy per frame, e.g. [1.0, 0.35]),
+frames), `init` (`joints`: start from `init_joints.csv`; `auto`: find the person and
+the pose from the first frame's images alone), `first_frame` (start there; needs `init: \"auto\"`),
+`recover` (notice a lost track and search the body again; default false), `passes` (spread factor of each pass of the stage hierarchy per frame, e.g. [1.0, 0.35]),
 `overlay_every` (0: no pictures), `makehuman` (folder of the body model).",
         |seq: &str, out: &str, m: Map| track(seq, out, &m)
     );

@@ -5,6 +5,7 @@
 //! (only the wall-time figures of the summary differ, as they do between any two runs).
 
 use super::joints::JOINT_COUNT;
+use super::loss::FrameStatus;
 use super::tracker::{TrackResult, Tracker};
 use crate::geometry::checkpoint::{Decoder, Encoder};
 use crate::geometry::{GeometryError, SplitMix64, Vec3};
@@ -70,6 +71,10 @@ impl TrackCheckpoint {
         e.f64(r.io_seconds);
         e.f64(r.start_seconds);
         e.usize(r.evaluations);
+        e.usize(r.first_frame);
+        e.f64s(&r.overlaps);
+        e.usize(r.status.len());
+        r.status.iter().for_each(|s| e.usize(s.code() as usize));
         e.u64(self.rng);
         e.usize(self.history.len());
         self.history.iter().for_each(|h| e.f64s(h));
@@ -103,6 +108,17 @@ impl TrackCheckpoint {
         result.io_seconds = d.f64("image time")?;
         result.start_seconds = d.f64("start time")?;
         result.evaluations = d.usize("evaluations")?;
+        result.first_frame = d.usize("first frame")?;
+        result.overlaps = d.f64s("overlaps")?;
+        let n = d.len(8, "frame states")?;
+        for _ in 0..n {
+            let c = d.usize("frame state")?;
+            let s = u8::try_from(c)
+                .ok()
+                .and_then(FrameStatus::from_code)
+                .ok_or_else(|| d.error("unknown frame state"))?;
+            result.status.push(s);
+        }
         let rng = d.u64("random state")?;
         let n = d.len(8, "last poses")?;
         let history = (0..n).map(|_| d.f64s("pose")).collect::<Result<_, _>>()?;

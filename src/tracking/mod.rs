@@ -12,9 +12,12 @@
 //! - [`clothing`], [`sequence`], [`sequence_files`]: synthetic multi-camera sequences with
 //!   ground truth, and reading any sequence folder;
 //! - [`pyramid`], [`texture`], [`cost`], [`annealing`], [`restarts`], [`tracker`]: the tracker;
+//! - [`visual_hull`], [`auto_start`], [`loss`]: finding the person without help (the
+//!   automatic start), noticing a lost track and finding the body again;
 //! - [`bvh_export`], [`overlay`], [`swing_metrics`], [`track_outputs`]: its outputs.
 
 pub mod annealing;
+pub mod auto_start;
 pub mod bvh_export;
 pub mod calibration;
 pub mod checkpoint;
@@ -23,9 +26,11 @@ pub mod club;
 pub mod correspondences;
 pub mod cost;
 pub mod dlt;
+pub mod frame_status;
 pub mod golf_metrics;
 pub mod golf_trial;
 pub mod joints;
+pub mod loss;
 pub mod marker_fit;
 pub mod marker_set;
 pub mod overlay;
@@ -40,3 +45,4 @@ pub mod swing_metrics;
 pub mod texture;
 pub mod track_outputs;
 pub mod tracker;
+pub mod visual_hull;

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 
 use super::bvh_export::{write_bvh, write_joints_csv, TrackingOutputError};
 use super::joints::{joint_index, TRACKING_JOINTS};
+use super::loss::FrameStatus;
 use super::overlay::write_overlay_png;
 use super::sequence_files::{Sequence, SequenceError};
 use super::swing_metrics::{swing_metrics, write_swing_metrics};
@@ -80,6 +81,9 @@ pub fn summary_json(seq: &Sequence, result: &TrackResult) -> String {
         "mpjpe_mm": result.mpjpe_mm(),
         "max_frame_mm": result.errors_mm.as_ref().map(|e| e.iter().cloned().fold(0.0, f64::max)),
         "arm_mm": result.joints_error_mm(&arm_joints()),
+        "first_frame": result.first_frame,
+        "lost_frames": result.frames_with(FrameStatus::Lost),
+        "recovered_frames": result.frames_with(FrameStatus::Recovered),
         "seconds_per_frame": result.seconds_per_frame(),
         "seconds_per_frame_by_stage": stages,
         "io_seconds_per_frame": result.io_seconds / result.joints.len().max(1) as f64,
@@ -117,7 +121,7 @@ pub fn write_track_outputs(
         }
         s.push('\n');
         for (k, (e, j)) in frames.iter().zip(joints).enumerate() {
-            let _ = write!(s, "{k},{e:.3}");
+            let _ = write!(s, "{},{e:.3}", result.first_frame + k);
             for x in j {
                 let _ = write!(s, ",{x:.3}");
             }
@@ -126,13 +130,15 @@ pub fn write_track_outputs(
         std::fs::write(&path, s).map_err(io(&path))?;
         files.push(path);
     }
+    files.push(write_status_csv(out, result)?);
     if options.overlay_every > 0 {
         let dir = out.join("overlay");
         std::fs::create_dir_all(&dir).map_err(io(&dir))?;
         for k in (0..result.joints.len()).step_by(options.overlay_every) {
-            let images = seq.frame_images(k)?;
-            let truth = seq.ground_truth.as_ref().and_then(|g| g.get(k));
-            let path = dir.join(format!("{k:04}.png"));
+            let f = result.first_frame + k;
+            let images = seq.frame_images(f)?;
+            let truth = seq.ground_truth.as_ref().and_then(|g| g.get(f));
+            let path = dir.join(format!("{f:04}.png"));
             write_overlay_png(&path, &images, &seq.cameras, &result.joints[k], truth)?;
             files.push(path);
         }
@@ -141,4 +147,19 @@ pub fn write_track_outputs(
     std::fs::write(&path, summary_json(seq, result)).map_err(io(&path))?;
     files.push(path);
     Ok(files)
+}
+
+/// Writes `track_status.csv`: per tracked frame (the sequence's numbering) its state
+/// (`tracked`, `lost`, `recovered`), the overlap of the pose with the foreground and the
+/// final cost of its search.
+pub fn write_status_csv(out: &Path, result: &TrackResult) -> Result<PathBuf, TrackOutputError> {
+    let path = out.join("track_status.csv");
+    let mut s = String::from("frame,status,overlap,cost\n");
+    for (k, st) in result.status.iter().enumerate() {
+        let o = result.overlaps.get(k).copied().unwrap_or(f64::NAN);
+        let c = result.costs.get(k).copied().unwrap_or(f64::NAN);
+        let _ = writeln!(s, "{},{},{o:.4},{c:.4}", result.first_frame + k, st.word());
+    }
+    std::fs::write(&path, s).map_err(io(&path))?;
+    Ok(path)
 }

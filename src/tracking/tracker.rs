@@ -75,6 +75,14 @@ pub struct TrackerOptions {
     /// prediction), the rest pose, and the predicted limb half bent or straightened (see
     /// [`limb_restarts`]).
     pub limb_restarts: bool,
+    /// Start without approximate joints: find the person and their pose from the first
+    /// frame's images alone ([`super::auto_start`]); `init_joints.csv` is not read.
+    pub auto_start: bool,
+    /// Notice a lost track from the image fit and find the body again
+    /// ([`super::loss`]); off by default until measured on the dance clips.
+    pub recover: bool,
+    /// First frame tracked (the start is made there).
+    pub first_frame: usize,
 }
 
 impl Default for TrackerOptions {
@@ -92,6 +100,9 @@ impl Default for TrackerOptions {
             passes: vec![1.0, 0.35],
             prior_weight: 0.05,
             limb_restarts: true,
+            auto_start: false,
+            recover: false,
+            first_frame: 0,
         }
     }
 }
@@ -115,6 +126,12 @@ pub struct TrackResult {
     pub start_seconds: f64,
     /// Cost evaluations in total.
     pub evaluations: usize,
+    /// The sequence's frame of the first tracked frame (its start).
+    pub first_frame: usize,
+    /// Overlap of each tracked frame's pose with the foreground ([`Tracker::overlap`]).
+    pub overlaps: Vec<f64>,
+    /// What happened to each frame (tracked, lost, recovered).
+    pub status: Vec<super::frame_status::FrameStatus>,
     /// Per-frame mean joint error against the ground truth (mm), when present.
     pub errors_mm: Option<Vec<f64>>,
     /// Per-frame, per-joint errors (mm), when the ground truth is present.
@@ -138,6 +155,14 @@ impl TrackResult {
                 .sum::<f64>()
                 / n
         })
+    }
+
+    /// The sequence's frames (numbered as in the sequence) whose state is `status`.
+    pub fn frames_with(&self, status: super::frame_status::FrameStatus) -> Vec<usize> {
+        (self.status.iter().enumerate())
+            .filter(|(_, s)| **s == status)
+            .map(|(k, _)| self.first_frame + k)
+            .collect()
     }
 
     /// Mean wall time per tracked frame (seconds), start excluded.
@@ -198,16 +223,19 @@ fn move_sigma(k: usize, group: PartGroup) -> f64 {
 /// The tracker's state between frames.
 pub struct Tracker {
     puppet: Puppet,
-    mesh: TrackingMesh,
+    pub(super) mesh: TrackingMesh,
     pub(super) colours: Option<Vec<[f32; 3]>>,
     pub(super) views: FrameViews,
-    workspaces: Vec<Mutex<CostWorkspace>>,
-    options: TrackerOptions,
+    pub(super) workspaces: Vec<Mutex<CostWorkspace>>,
+    pub(super) options: TrackerOptions,
     pub(super) rng: SplitMix64,
     pub(super) history: Vec<Vec<f64>>,
     scratch: AnnealScratch,
     pub(super) stage_seconds: Vec<f64>,
     pub(super) evaluations: usize,
+    /// Further starting points of the limb stages (a pose library, during an automatic
+    /// start or a recovery).
+    pub(super) extra_seeds: Vec<Vec<f64>>,
 }
 
 impl Tracker {
@@ -272,6 +300,7 @@ impl Tracker {
             scratch: AnnealScratch::default(),
             stage_seconds: vec![0.0; STAGES.len()],
             evaluations: 0,
+            extra_seeds: Vec::new(),
         })
     }
 
@@ -335,6 +364,9 @@ impl Tracker {
                     &mut settings.seeds,
                 );
             }
+            if s >= 2 {
+                settings.seeds.extend(self.extra_seeds.iter().cloned());
+            }
             let app = Appearance {
                 puppet: &self.puppet,
                 mesh: &self.mesh,
@@ -375,7 +407,7 @@ impl Tracker {
     }
 
     /// Learns the colours from the current frame at pose `params` (full resolution).
-    fn learn(&mut self, params: &[f64]) -> usize {
+    pub(super) fn learn(&mut self, params: &[f64]) -> usize {
         let app = Appearance {
             puppet: &self.puppet,
             mesh: &self.mesh,
@@ -413,6 +445,12 @@ impl Tracker {
         self.views.set_frame(images);
         let rest = self.puppet.rest_params();
         let fitted = self.puppet.fit_to_joints(approx, &rest);
+        Ok(self.refine_start(fitted))
+    }
+
+    /// The start's refinement from a first pose `fitted` (current frame loaded): alternately
+    /// learns the colours and searches the pose, with narrowing moves.
+    pub(super) fn refine_start(&mut self, fitted: Vec<f64>) -> Vec<f64> {
         self.colours = None;
         let mut pose = fitted.clone();
         for scale in [0.4, 0.3, 0.2, 0.15, 0.1] {
@@ -420,9 +458,8 @@ impl Tracker {
             (pose, _) = self.search_with_prior(&pose, scale, &fitted);
         }
         self.learn(&pose);
-        let refined = pose;
-        self.history = vec![refined.clone()];
-        Ok(refined)
+        self.history = vec![pose.clone()];
+        pose
     }
 
     /// Frame 0 from a known pose (no search): learns the colours there.
@@ -495,6 +532,12 @@ impl Tracker {
             self.history.remove(0);
         }
         Ok((params, cost))
+    }
+
+    /// Forgets the motion so far: the next frame is predicted from `params` alone (after a
+    /// recovery).
+    pub fn restart_history(&mut self, params: &[f64]) {
+        self.history = vec![params.to_vec()];
     }
 
     /// The tracking joints of pose `params`.
