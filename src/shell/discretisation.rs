@@ -8,8 +8,10 @@
 use rayon::prelude::*;
 
 use super::error::ShellError;
+use super::fabric_law::FabricLaw;
 use super::kinematics::RestGeometry;
 use super::mls::{shape_functions, ShapeValues};
+use super::moment::MomentPoint;
 use super::neighbours::{local_spacing, PointGrid};
 use super::problem::{gauss_legendre, Constraint, Direction, ShellParameters, ShellProblem};
 use super::surface::V3;
@@ -56,6 +58,11 @@ pub struct Discretisation {
     pub quad: Vec<QuadPoint>,
     /// Per node: its rows' terms.
     pub terms: Vec<NodeTerms>,
+    /// A fabric's nonlinear law, used in place of `problem.material` for the strain energy
+    /// when set ([`Discretisation::with_fabric_law`]).
+    pub law: Option<FabricLaw>,
+    /// Edge moments ([`Discretisation::add_edge_moment`]).
+    pub moments: Vec<MomentPoint>,
     grid: PointGrid,
     max_radius: f64,
 }
@@ -146,11 +153,29 @@ impl Discretisation {
             radius,
             quad: Vec::new(),
             terms: Vec::new(),
+            law: None,
+            moments: Vec::new(),
             grid,
             max_radius,
         };
         disc.quad = disc.cell_points(cells)?;
         disc.terms = disc.node_terms(cells)?;
+        Ok(disc)
+    }
+
+    /// Builds the discretisation of a shell of the fabric law `law`: the problem's material
+    /// becomes the law's initial-slope linear shell (for the penalty scales; its areal density
+    /// is kept) and the strain energy is the law's ([`FabricLaw`]).
+    pub fn with_fabric_law(
+        mut problem: ShellProblem,
+        params: ShellParameters,
+        law: FabricLaw,
+    ) -> Result<Discretisation, ShellError> {
+        problem.material = law
+            .tangent_material(problem.material.density)
+            .map_err(ShellError::Invalid)?;
+        let mut disc = Discretisation::new(problem, params)?;
+        disc.law = Some(law);
         Ok(disc)
     }
 
