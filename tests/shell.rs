@@ -107,3 +107,48 @@ fn points_outside_the_domain_and_coincident_points_are_errors() {
     .to_string();
     assert!(e.contains("penalty"), "{e}");
 }
+
+/// The ten measured fabrics of Wang et al. 2011 (research data, read at run time), or None
+/// with a message when they are absent.
+fn wang_fabrics() -> Option<Vec<emilion::kes::FabricSpec>> {
+    let dir = emilion::geometry::files::data_dir().join("fabrics/wang2011");
+    if !dir.is_dir() {
+        eprintln!("skipped: {} is absent (research data)", dir.display());
+        return None;
+    }
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "json"))
+        .collect();
+    files.sort();
+    Some(
+        files
+            .iter()
+            .map(|p| emilion::kes::import_wang(p).unwrap())
+            .collect(),
+    )
+}
+
+#[test]
+fn kes_tensile_and_bending_rigs_on_the_shell_give_back_measured_curves_within_three_percent() {
+    use emilion::kes::shell_rigs::{run_shell_rigs, ShellRigOptions};
+    let Some(fabrics) = wang_fabrics() else {
+        return;
+    };
+    for spec in fabrics.iter() {
+        let t0 = std::time::Instant::now();
+        let r = run_shell_rigs(spec, &ShellRigOptions::default()).unwrap();
+        for row in &r.rows {
+            println!(
+                "{} {} rms {:.3} % max_x {:.4} ({} points) {:.2} s",
+                r.name,
+                row.test,
+                row.rms_pct,
+                row.max_x,
+                row.simulated.len(),
+                t0.elapsed().as_secs_f64()
+            );
+        }
+    }
+}

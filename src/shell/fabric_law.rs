@@ -48,18 +48,33 @@ impl FabricLaw {
         Ok(FabricLaw { twist, ..f })
     }
 
-    /// The linear shell of the law's initial slopes (membrane diag(warp, weft, shear),
+    /// The linear shell of the law's initial slopes, or of its secants to 1 % strain, 0.01 rad
+    /// and 1 1/m where larger (membrane diag(warp, weft, shear),
     /// bending diag(warp, weft, twist)) with areal density `density`: the stiffness scales the
     /// penalties of the boundary conditions use. Errors name a mode whose slope is not
     /// positive and finite.
     pub fn tangent_material(&self, density: f64) -> Result<ShellMaterial, String> {
         let l = &self.law;
+        // the initial slope, or the secant to a small deformation where the curve starts flat
+        // (a KES power law): 1 % strain, 0.01 rad, 1 1/m
         let slopes = [
-            ("warp tension", l.tension(Direction::Warp, 0.0).1),
-            ("weft tension", l.tension(Direction::Weft, 0.0).1),
-            ("shear", l.shear(0.0).1),
-            ("warp bending", l.bending(Direction::Warp, 0.0).1),
-            ("weft bending", l.bending(Direction::Weft, 0.0).1),
+            (
+                "warp tension",
+                slope(|x| l.tension(Direction::Warp, x), 0.01),
+            ),
+            (
+                "weft tension",
+                slope(|x| l.tension(Direction::Weft, x), 0.01),
+            ),
+            ("shear", slope(|x| l.shear(x), 0.01)),
+            (
+                "warp bending",
+                slope(|x| l.bending(Direction::Warp, x), 1.0),
+            ),
+            (
+                "weft bending",
+                slope(|x| l.bending(Direction::Weft, x), 1.0),
+            ),
         ];
         for (name, s) in slopes {
             if !(s.is_finite() && s > 0.0) {
@@ -108,6 +123,12 @@ impl FabricLaw {
         }
         w + (kap[2] * kap[2]).scale(0.5 * self.twist)
     }
+}
+
+/// The largest of a curve's slope at 0, its slope at `x` and its secant to `x`.
+fn slope(curve: impl Fn(f64) -> (f64, f64, f64), x: f64) -> f64 {
+    let (f, d, _) = curve(x);
+    d.max(f / x).max(curve(0.0).1)
 }
 
 /// The energy of an odd law (force, stiffness, energy) = `law(|x|)` at the jet `x`: even in x,
