@@ -49,8 +49,8 @@ impl Default for ShellRigOptions {
     fn default() -> Self {
         ShellRigOptions {
             points_along: 11,
-            tensile_steps: 40,
-            bending_steps: 30,
+            tensile_steps: 20,
+            bending_steps: 15,
             params: ShellParameters::default(),
         }
     }
