@@ -133,7 +133,7 @@ pub fn residual(disc: &Discretisation, u: &[f64], lambda: f64) -> Vec<f64> {
         .map(|t| node_rows(t, disc, &jets, u, lambda, false).0)
         .collect();
     let mut res = rows.concat();
-    add_moment_residual(disc, u, lambda, &mut res);
+    add_moment_residual(&disc.moments, u, lambda, &mut res);
     res
 }
 
@@ -164,8 +164,8 @@ pub fn residual_and_tangent(
             }
         }
     }
-    add_moment_residual(disc, u, lambda, &mut res);
-    add_moment_tangent(disc, u, lambda, &mut trip);
+    add_moment_residual(&disc.moments, u, lambda, &mut res);
+    add_moment_tangent(&disc.moments, u, lambda, &mut trip);
     let mat = SparseColMat::try_new_from_triplets(n, n, &trip)
         .map_err(|e| ShellError::Solver(format!("tangent matrix: {e:?}")))?;
     Ok((res, mat))

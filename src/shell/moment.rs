@@ -3,14 +3,12 @@
 //! from the rest tangent towards the rest normal, in the plane of the two:
 //! θ = atan2(a_k·N, a_k·T), T = X,k/|X,k|, N the rest normal. The residual and the tangent are
 //! its exact first and second derivatives through the MLS shape functions, so the Newton
-//! tangent stays exact (and symmetric). A pure-bending rig loads a strip with it: under a
+//! tangent stays exact (and symmetric). The points are built by
+//! [`super::discretisation::Discretisation::add_edge_moment`]. A pure-bending rig loads a strip with it: under a
 //! uniform moment the strip's curvature is uniform.
 
 use faer::sparse::Triplet;
 
-use super::discretisation::Discretisation;
-use super::error::ShellError;
-use super::problem::{gauss_legendre, EDGE_NAMES};
 use super::surface::V3;
 
 /// One Gauss point of an edge moment.
@@ -30,13 +28,13 @@ pub struct MomentPoint {
     pub weight: f64,
     /// Line weight (m) of the point on its edge.
     pub line: f64,
-    /// The edge (index into [`EDGE_NAMES`]).
+    /// The edge (index into [`super::problem::EDGE_NAMES`]).
     pub edge: usize,
 }
 
 impl MomentPoint {
     /// (p, q) = (a·T, a·N) of the deformed tangent a at `u`.
-    fn components(&self, u: &[f64]) -> (f64, f64) {
+    pub fn components(&self, u: &[f64]) -> (f64, f64) {
         let mut a = self.rest_tangent;
         for (&j, &s) in self.nodes.iter().zip(&self.slope) {
             a += V3::new(u[3 * j], u[3 * j + 1], u[3 * j + 2]) * s;
@@ -45,99 +43,20 @@ impl MomentPoint {
     }
 }
 
-impl Discretisation {
-    /// Gauss points along `edge` (0 to 3, [`EDGE_NAMES`]) carrying `moment_per_width` (N·m/m
-    /// at load factor 1).
-    fn edge_points(
-        &self,
-        edge: usize,
-        moment_per_width: f64,
-    ) -> Result<Vec<MomentPoint>, ShellError> {
-        if edge > 3 {
-            return Err(ShellError::Invalid(format!(
-                "edge index must be 0 to 3 ({EDGE_NAMES:?}), got {edge}"
-            )));
-        }
-        if !moment_per_width.is_finite() {
-            return Err(ShellError::Invalid(format!(
-                "edge moment must be finite, got {moment_per_width}"
-            )));
-        }
-        let dom = self.problem.domain;
-        let (k, o) = (edge / 2, 1 - edge / 2);
-        let h = self.spacing.iter().sum::<f64>() / self.len().max(1) as f64;
-        let span = dom[2 * o + 1] - dom[2 * o];
-        let segs = ((2.0 * span / h).ceil() as usize).clamp(1, 10_000);
-        let len = span / segs as f64;
-        let (gp, gw) = gauss_legendre(self.params.gauss);
-        let mut out = Vec::with_capacity(segs * gp.len());
-        for sgi in 0..segs {
-            for (g, w) in gp.iter().zip(gw) {
-                let mut p = [0.0; 2];
-                p[k] = dom[edge];
-                p[o] = dom[2 * o] + len * (sgi as f64 + 0.5 * (g + 1.0));
-                let sp = self.problem.surface.at(p);
-                let normal = sp.d1[0].cross(&sp.d1[1]).normalize();
-                let line = w * 0.5 * len * sp.d1[o].norm();
-                let s = self.shape_at(p, &|| format!("a point of edge {}", EDGE_NAMES[edge]))?;
-                out.push(MomentPoint {
-                    slope: s.values.iter().map(|v| v[1 + k]).collect(),
-                    nodes: s.nodes,
-                    rest_tangent: sp.d1[k],
-                    t: sp.d1[k].normalize(),
-                    n: normal,
-                    weight: moment_per_width * line,
-                    line,
-                    edge,
-                });
-            }
-        }
-        Ok(out)
+/// The mean rotation θ (rad) over `points` (weighted by their line weights).
+pub fn mean_rotation(points: &[MomentPoint], u: &[f64]) -> f64 {
+    let (mut sum, mut len) = (0.0, 0.0);
+    for m in points {
+        let (p, q) = m.components(u);
+        sum += m.line * q.atan2(p);
+        len += m.line;
     }
-
-    /// Adds a moment per unit rest width `moment_per_width` (N·m/m at load factor 1) along
-    /// `edge` (0 to 3, [`EDGE_NAMES`]): positive turns the tangent across the edge (along ξ^k)
-    /// towards the rest normal. It scales with the load factor like the other loads.
-    pub fn add_edge_moment(
-        &mut self,
-        edge: usize,
-        moment_per_width: f64,
-    ) -> Result<(), ShellError> {
-        let pts = self.edge_points(edge, moment_per_width)?;
-        self.moments.extend(pts);
-        Ok(())
-    }
-
-    /// The mean rotation θ (rad) along `edge` of the deformed tangent across it, towards the
-    /// rest normal (the angle an edge moment works through).
-    pub fn edge_rotation(&self, edge: usize, u: &[f64]) -> Result<f64, ShellError> {
-        let pts = self.edge_points(edge, 0.0)?;
-        let (mut sum, mut len) = (0.0, 0.0);
-        for m in &pts {
-            let (p, q) = m.components(u);
-            sum += m.line * q.atan2(p);
-            len += m.line;
-        }
-        Ok(sum / len)
-    }
-
-    /// The norm of the external load vector at load factor 1 (area and point loads and edge
-    /// moments at rest): the scale of Newton's relative residual.
-    pub fn external_load_norm(&self) -> f64 {
-        let mut f: Vec<f64> = self.terms.iter().flat_map(|t| t.load).collect();
-        let u = vec![0.0; f.len()];
-        let mut r = vec![0.0; f.len()];
-        add_moment_residual(self, &u, 1.0, &mut r);
-        for (a, b) in f.iter_mut().zip(&r) {
-            *a -= b;
-        }
-        f.iter().map(|x| x * x).sum::<f64>().sqrt()
-    }
+    sum / len
 }
 
 /// Adds the edge moments' share of the residual at load factor `lambda`: −λ w ∂θ/∂u.
-pub fn add_moment_residual(disc: &Discretisation, u: &[f64], lambda: f64, res: &mut [f64]) {
-    for m in &disc.moments {
+pub fn add_moment_residual(moments: &[MomentPoint], u: &[f64], lambda: f64, res: &mut [f64]) {
+    for m in moments {
         let (p, q) = m.components(u);
         let rho2 = p * p + q * q;
         let g = (m.t * (-q) + m.n * p) / rho2;
@@ -152,12 +71,12 @@ pub fn add_moment_residual(disc: &Discretisation, u: &[f64], lambda: f64, res: &
 /// Adds the edge moments' share of the tangent at load factor `lambda`: −λ w ∂²θ/∂u², as
 /// triplets (the same entries on every call, so the sparsity pattern does not change).
 pub fn add_moment_tangent(
-    disc: &Discretisation,
+    moments: &[MomentPoint],
     u: &[f64],
     lambda: f64,
     trip: &mut Vec<Triplet<usize, usize, f64>>,
 ) {
-    for m in &disc.moments {
+    for m in moments {
         let (p, q) = m.components(u);
         let rho4 = (p * p + q * q).powi(2);
         let (hpp, hpq, hqq) = (
