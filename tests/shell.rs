@@ -107,3 +107,75 @@ fn points_outside_the_domain_and_coincident_points_are_errors() {
     .to_string();
     assert!(e.contains("penalty"), "{e}");
 }
+
+/// The ten measured fabrics of Wang et al. 2011 (research data, read at run time), or None
+/// with a message when they are absent.
+fn wang_fabrics() -> Option<Vec<emilion::kes::FabricSpec>> {
+    let dir = emilion::geometry::files::data_dir().join("fabrics/wang2011");
+    if !dir.is_dir() {
+        eprintln!("skipped: {} is absent (research data)", dir.display());
+        return None;
+    }
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "json"))
+        .collect();
+    files.sort();
+    Some(
+        files
+            .iter()
+            .map(|p| emilion::kes::import_wang(p).unwrap())
+            .collect(),
+    )
+}
+
+/// KES-FB1 tensile and KES-FB2 pure-bending rigs on the shell with the fabric's measured law:
+/// every loading path within 3 % RMS (of the curve's range) of the measured loading curve, for
+/// a woven denim and the knit with the most curved bending curve (gray interlock). Ground
+/// truth: the measured curves (Wang et al. 2011), not the shell's output.
+#[test]
+fn kes_tensile_and_bending_rigs_on_the_shell_give_back_measured_curves_within_three_percent() {
+    use emilion::kes::shell_rigs::{run_shell_rigs, ShellRigOptions};
+    let Some(fabrics) = wang_fabrics() else {
+        return;
+    };
+    let chosen: Vec<_> = fabrics
+        .iter()
+        .filter(|f| f.name == "11oz-black-denim" || f.name == "gray-interlock")
+        .collect();
+    assert_eq!(chosen.len(), 2);
+    for spec in chosen {
+        let r = run_shell_rigs(spec, &ShellRigOptions::default()).unwrap();
+        assert_eq!(r.rows.len(), 4, "{}: {:?}", r.name, r.rows);
+        for row in &r.rows {
+            println!(
+                "{} {}: RMS {:.3} %, reached {:.4}",
+                r.name, row.test, row.rms_pct, row.max_x
+            );
+            assert!(
+                row.rms_pct <= 3.0,
+                "{} {}: {} %",
+                r.name,
+                row.test,
+                row.rms_pct
+            );
+            // the rig reaches the end of the measured range it was asked for (Fm, or the
+            // bending amplitude) within 2 %
+            let end = row.measured.iter().map(|p| p[0]).fold(0.0, f64::max);
+            let want = if row.test.starts_with("bending") {
+                end.min(250.0)
+            } else {
+                end
+            };
+            assert!(
+                row.max_x >= 0.98 * want,
+                "{} {}: reached {} of {}",
+                r.name,
+                row.test,
+                row.max_x,
+                want
+            );
+        }
+    }
+}

@@ -1,7 +1,7 @@
 //! Measured fabrics: the KES-F units and their conversion to SI (in one place), the fabric
 //! file format, the import of the Wang 2011 measured fabrics, the KES parameter formulas
 //! applied to measured or simulated curves, the virtual Kawabata rigs, the law built from
-//! measurements and its fitting, damping from free oscillation, and the lab that runs it all.
+//! measurements and its fitting, the tensile and bending rigs on the meshless shell, damping from free oscillation, and the lab that runs it all.
 
 pub mod calibrate;
 pub mod compression;
@@ -17,6 +17,7 @@ pub(crate) mod quasi_static;
 pub mod ranges;
 pub mod rig;
 pub mod rig_parameters;
+pub mod shell_rigs;
 pub mod units;
 pub mod wang;
 

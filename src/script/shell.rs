@@ -1,15 +1,43 @@
 //! Script bindings of the meshless Kirchhoff–Love shell: its benchmark cases (the work lives in
-//! `crate::shell::benchmarks`).
+//! `crate::shell::benchmarks`) and the KES rigs on it (`crate::kes::shell_rigs`).
 
 use rhai::{Array, Dynamic, Map, INT};
 
 use super::convert::{rt_err, update_from_map, RResult};
 use super::{function, modules::ApiBuilder};
+use crate::kes::shell_rigs::{run_shell_rigs, ShellRigOptions};
 use crate::shell::benchmarks::{
     heavy_cantilever, pinched_cylinder, pinched_hemisphere, scordelis_lo, square_plate,
     BenchmarkResult,
 };
 use crate::shell::ShellParameters;
+
+/// Shell rig options from a script map (`points_along`, `tensile_steps`, `bending_steps`).
+fn rig_options(options: &Map) -> RResult<ShellRigOptions> {
+    let mut o = ShellRigOptions::default();
+    for (k, v) in options {
+        let n = v
+            .as_int()
+            .map_err(|_| rt_err(format!("shell::kes_rigs: option `{k}` must be an int")))?;
+        let n = usize::try_from(n).map_err(|_| {
+            rt_err(format!(
+                "shell::kes_rigs: option `{k}` must be ≥ 0, got {n}"
+            ))
+        })?;
+        match k.as_str() {
+            "points_along" => o.points_along = n,
+            "tensile_steps" => o.tensile_steps = n,
+            "bending_steps" => o.bending_steps = n,
+            other => {
+                return Err(rt_err(format!(
+                    "shell::kes_rigs: unknown option `{other}` (points_along, tensile_steps, bending_steps)"
+                )))
+            }
+        }
+    }
+    o.validate().map_err(rt_err)?;
+    Ok(o)
+}
 
 fn result_map(r: &BenchmarkResult) -> Map {
     let mut m = Map::new();
@@ -24,6 +52,27 @@ fn result_map(r: &BenchmarkResult) -> Map {
 
 /// Registers the shell functions.
 pub fn register(engine: &mut ApiBuilder) {
+    function!(engine, "shell::kes_rigs", ["fabric: KesFabric", "options: Map", "Map"],
+        "Runs the KES-FB1 tensile and KES-FB2 pure-bending rigs on the meshless shell with the\nfabric's measured law (elastic backbone), for every measured tensile and bending curve the\nfabric has, and compares each loading path with the measured loading branch. Options:\n`points_along` (11), `tensile_steps` (20), `bending_steps` (15). Returns #{name,\nworst_rms_pct, rows: [#{test, rms_pct (% of the measured range), max_x (strain or 1/m)}]}.",
+        |f: super::kes::KesFabric, options: Map| -> RResult<Map> {
+            let r = run_shell_rigs(&f.0, &rig_options(&options)?).map_err(rt_err)?;
+            let rows: Array = r
+                .rows
+                .iter()
+                .map(|row| {
+                    let mut m = Map::new();
+                    m.insert("test".into(), Dynamic::from(row.test.clone()));
+                    m.insert("rms_pct".into(), Dynamic::from_float(row.rms_pct));
+                    m.insert("max_x".into(), Dynamic::from_float(row.max_x));
+                    Dynamic::from_map(m)
+                })
+                .collect();
+            let mut m = Map::new();
+            m.insert("name".into(), Dynamic::from(r.name.clone()));
+            m.insert("worst_rms_pct".into(), Dynamic::from_float(r.worst()));
+            m.insert("rows".into(), Dynamic::from_array(rows));
+            Ok(m)
+        });
     function!(engine, "shell::benchmark", ["case: String", "points: int", "options: Map", "Map"],
         "Runs one shell benchmark with `points` sample points along its longer side and the\nshell parameters `options` (fields of ShellParameters: basis, support_factor,\ncell_factor, gauss, penalty, ...; #{} for the defaults). `case`:\n\"plate_simply_supported\", \"plate_clamped\" (centre deflection / (q a⁴/D)), \"cantilever\"\n(tip angle, degrees, worst of q L³/B = 1 … 20), \"scordelis_lo\", \"pinched_cylinder\",\n\"pinched_hemisphere\". Returns #{name, points, value, reference, error (percent; degrees\nfor the cantilever), seconds, rows (cantilever: [q L³/B, angle, reference] per row)}.",
         |case: &str, points: INT, options: Map| -> RResult<Map> {

@@ -11,7 +11,8 @@ use rayon::prelude::*;
 use super::discretisation::{Discretisation, NodeTerms};
 use super::error::ShellError;
 use super::jet::NV;
-use super::kinematics::{energy_density, rest_locals};
+use super::kinematics::{energy_density_law, rest_locals};
+use super::moment::{add_moment_residual, add_moment_tangent};
 
 /// The weighted gradient and Hessian of the energy at one background point.
 type PointJet = ([f64; NV], Box<[[f64; NV]; NV]>);
@@ -19,6 +20,7 @@ type PointJet = ([f64; NV], Box<[[f64; NV]; NV]>);
 /// Weighted gradient and Hessian of the energy at every background point.
 fn point_jets(disc: &Discretisation, u: &[f64], tangent: bool) -> Vec<PointJet> {
     let mat = &disc.problem.material;
+    let law = disc.law.as_ref();
     disc.quad
         .par_iter()
         .map(|q| {
@@ -31,7 +33,7 @@ fn point_jets(disc: &Discretisation, u: &[f64], tangent: bool) -> Vec<PointJet> 
                     }
                 }
             }
-            let w = energy_density(&l, &q.rest, mat);
+            let w = energy_density_law(&l, &q.rest, mat, law);
             let g = w.g.map(|x| x * q.weight);
             let mut h = Box::new([[0.0; NV]; NV]);
             if tangent {
@@ -130,7 +132,9 @@ pub fn residual(disc: &Discretisation, u: &[f64], lambda: f64) -> Vec<f64> {
         .par_iter()
         .map(|t| node_rows(t, disc, &jets, u, lambda, false).0)
         .collect();
-    rows.concat()
+    let mut res = rows.concat();
+    add_moment_residual(&disc.moments, u, lambda, &mut res);
+    res
 }
 
 /// The residual and the tangent matrix (sparse, column-compressed) at load factor `lambda`.
@@ -160,6 +164,8 @@ pub fn residual_and_tangent(
             }
         }
     }
+    add_moment_residual(&disc.moments, u, lambda, &mut res);
+    add_moment_tangent(&disc.moments, u, lambda, &mut trip);
     let mat = SparseColMat::try_new_from_triplets(n, n, &trip)
         .map_err(|e| ShellError::Solver(format!("tangent matrix: {e:?}")))?;
     Ok((res, mat))

@@ -8,10 +8,14 @@
 use rayon::prelude::*;
 
 use super::error::ShellError;
+use super::fabric_law::FabricLaw;
 use super::kinematics::RestGeometry;
 use super::mls::{shape_functions, ShapeValues};
+use super::moment::{add_moment_residual, mean_rotation, MomentPoint};
 use super::neighbours::{local_spacing, PointGrid};
-use super::problem::{gauss_legendre, Constraint, Direction, ShellParameters, ShellProblem};
+use super::problem::{
+    gauss_legendre, Constraint, Direction, ShellParameters, ShellProblem, EDGE_NAMES,
+};
 use super::surface::V3;
 use crate::limits;
 
@@ -56,6 +60,11 @@ pub struct Discretisation {
     pub quad: Vec<QuadPoint>,
     /// Per node: its rows' terms.
     pub terms: Vec<NodeTerms>,
+    /// A fabric's nonlinear law, used in place of `problem.material` for the strain energy
+    /// when set ([`Discretisation::with_fabric_law`]).
+    pub law: Option<FabricLaw>,
+    /// Edge moments ([`Discretisation::add_edge_moment`]).
+    pub moments: Vec<MomentPoint>,
     grid: PointGrid,
     max_radius: f64,
 }
@@ -146,11 +155,29 @@ impl Discretisation {
             radius,
             quad: Vec::new(),
             terms: Vec::new(),
+            law: None,
+            moments: Vec::new(),
             grid,
             max_radius,
         };
         disc.quad = disc.cell_points(cells)?;
         disc.terms = disc.node_terms(cells)?;
+        Ok(disc)
+    }
+
+    /// Builds the discretisation of a shell of the fabric law `law`: the problem's material
+    /// becomes the law's initial-slope linear shell (for the penalty scales; its areal density
+    /// is kept) and the strain energy is the law's ([`FabricLaw`]).
+    pub fn with_fabric_law(
+        mut problem: ShellProblem,
+        params: ShellParameters,
+        law: FabricLaw,
+    ) -> Result<Discretisation, ShellError> {
+        problem.material = law
+            .tangent_material(problem.material.density)
+            .map_err(ShellError::Invalid)?;
+        let mut disc = Discretisation::new(problem, params)?;
+        disc.law = Some(law);
         Ok(disc)
     }
 
@@ -306,6 +333,88 @@ impl Discretisation {
             t.columns = cols;
         }
         Ok(terms)
+    }
+
+    /// Gauss points along `edge` (0 to 3, [`EDGE_NAMES`]) carrying `moment_per_width` (N·m/m
+    /// at load factor 1).
+    fn edge_points(
+        &self,
+        edge: usize,
+        moment_per_width: f64,
+    ) -> Result<Vec<MomentPoint>, ShellError> {
+        if edge > 3 {
+            return Err(ShellError::Invalid(format!(
+                "edge index must be 0 to 3 ({EDGE_NAMES:?}), got {edge}"
+            )));
+        }
+        if !moment_per_width.is_finite() {
+            return Err(ShellError::Invalid(format!(
+                "edge moment must be finite, got {moment_per_width}"
+            )));
+        }
+        let dom = self.problem.domain;
+        let (k, o) = (edge / 2, 1 - edge / 2);
+        let h = self.spacing.iter().sum::<f64>() / self.len().max(1) as f64;
+        let span = dom[2 * o + 1] - dom[2 * o];
+        let segs = ((2.0 * span / h).ceil() as usize).clamp(1, 10_000);
+        let len = span / segs as f64;
+        let (gp, gw) = gauss_legendre(self.params.gauss);
+        let mut out = Vec::with_capacity(segs * gp.len());
+        for sgi in 0..segs {
+            for (g, w) in gp.iter().zip(gw) {
+                let mut p = [0.0; 2];
+                p[k] = dom[edge];
+                p[o] = dom[2 * o] + len * (sgi as f64 + 0.5 * (g + 1.0));
+                let sp = self.problem.surface.at(p);
+                let normal = sp.d1[0].cross(&sp.d1[1]).normalize();
+                let line = w * 0.5 * len * sp.d1[o].norm();
+                let s = self.shape_at(p, &|| format!("a point of edge {}", EDGE_NAMES[edge]))?;
+                out.push(MomentPoint {
+                    slope: s.values.iter().map(|v| v[1 + k]).collect(),
+                    nodes: s.nodes,
+                    rest_tangent: sp.d1[k],
+                    t: sp.d1[k].normalize(),
+                    n: normal,
+                    weight: moment_per_width * line,
+                    line,
+                    edge,
+                });
+            }
+        }
+        Ok(out)
+    }
+
+    /// Adds a moment per unit rest width `moment_per_width` (N·m/m at load factor 1) along
+    /// `edge` (0 to 3, [`EDGE_NAMES`]): positive turns the tangent across the edge (along ξ^k)
+    /// towards the rest normal. It scales with the load factor like the other loads.
+    pub fn add_edge_moment(
+        &mut self,
+        edge: usize,
+        moment_per_width: f64,
+    ) -> Result<(), ShellError> {
+        let pts = self.edge_points(edge, moment_per_width)?;
+        self.moments.extend(pts);
+        Ok(())
+    }
+
+    /// The mean rotation θ (rad) along `edge` of the deformed tangent across it, towards the
+    /// rest normal (the angle an edge moment works through).
+    pub fn edge_rotation(&self, edge: usize, u: &[f64]) -> Result<f64, ShellError> {
+        let pts = self.edge_points(edge, 0.0)?;
+        Ok(mean_rotation(&pts, u))
+    }
+
+    /// The norm of the external load vector at load factor 1 (area and point loads and edge
+    /// moments at rest): the scale of Newton's relative residual.
+    pub fn external_load_norm(&self) -> f64 {
+        let mut f: Vec<f64> = self.terms.iter().flat_map(|t| t.load).collect();
+        let u = vec![0.0; f.len()];
+        let mut r = vec![0.0; f.len()];
+        add_moment_residual(&self.moments, &u, 1.0, &mut r);
+        for (a, b) in f.iter_mut().zip(&r) {
+            *a -= b;
+        }
+        f.iter().map(|x| x * x).sum::<f64>().sqrt()
     }
 
     /// Number of sample points.

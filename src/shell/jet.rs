@@ -51,7 +51,7 @@ impl Jet {
     }
 
     /// f(self) for a scalar function with value f0, first derivative f1 and second f2 there.
-    fn chain(&self, f0: f64, f1: f64, f2: f64) -> Jet {
+    pub fn chain(&self, f0: f64, f1: f64, f2: f64) -> Jet {
         let mut r = Jet::constant(f0);
         for i in 0..NV {
             r.g[i] = f1 * self.g[i];
@@ -66,6 +66,13 @@ impl Jet {
     pub fn sqrt(&self) -> Jet {
         let s = self.v.sqrt();
         self.chain(s, 0.5 / s, -0.25 / (s * self.v))
+    }
+
+    /// Arc sine (of a value inside (−1, 1)).
+    pub fn asin(&self) -> Jet {
+        let c = 1.0 - self.v * self.v;
+        let r = 1.0 / c.sqrt();
+        self.chain(self.v.asin(), r, self.v * r / c)
     }
 
     /// Reciprocal (of a non-zero value).

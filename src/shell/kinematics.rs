@@ -10,6 +10,7 @@
 //! W = ½ εᵀ D_m ε + ½ κᵀ D_b κ (Voigt, engineering shear). Large rotations and large
 //! displacements are exact; the law is linear in these strains (small strains).
 
+use super::fabric_law::FabricLaw;
 use super::jet::{cross, dot, Jet, JetVec};
 use super::material::ShellMaterial;
 use super::surface::{SurfacePoint, V3};
@@ -87,6 +88,17 @@ fn quadratic(d: &[[f64; 3]; 3], v: &[Jet; 3]) -> Jet {
 /// The strain energy per unit rest area as a jet in the 15 local variables
 /// `locals` = (a₁, a₂, a₁₁, a₁₂, a₂₂), each a 3-vector.
 pub fn energy_density(locals: &[f64; 15], rest: &RestGeometry, mat: &ShellMaterial) -> Jet {
+    energy_density_law(locals, rest, mat, None)
+}
+
+/// [`energy_density`] with the fabric's nonlinear law `law` in place of the linear `mat`
+/// when given ([`FabricLaw::energy`], same strains).
+pub fn energy_density_law(
+    locals: &[f64; 15],
+    rest: &RestGeometry,
+    mat: &ShellMaterial,
+    law: Option<&FabricLaw>,
+) -> Jet {
     let var = |k: usize| -> JetVec {
         [
             Jet::variable(locals[3 * k], 3 * k),
@@ -112,7 +124,10 @@ pub fn energy_density(locals: &[f64; 15], rest: &RestGeometry, mat: &ShellMateri
     ];
     let eps = to_voigt(&rest.to_local, e);
     let kap = to_voigt(&rest.to_local, k);
-    quadratic(&mat.membrane, &eps) + quadratic(&mat.bending, &kap)
+    match law {
+        Some(f) => f.energy(&eps, &kap),
+        None => quadratic(&mat.membrane, &eps) + quadratic(&mat.bending, &kap),
+    }
 }
 
 /// The rest values of the 15 local variables at a point.

@@ -9,7 +9,8 @@
 //!
 //! Files: [`mls`] shape functions, [`neighbours`] the point grid and spacing, [`surface`] the
 //! rest surfaces, [`jet`] second-order automatic differentiation, [`kinematics`] strains and
-//! energy density, [`material`] the laws, [`problem`] problems and parameters,
+//! energy density, [`material`] the linear laws, [`fabric_law`] a fabric's
+//! measured (nonlinear) law, [`moment`] edge moments, [`problem`] problems and parameters,
 //! [`discretisation`] background cells and quadrature, [`assembly`] residual and tangent,
 //! [`solve`] Newton, [`benchmarks`] the shell obstacle course.
 
@@ -17,10 +18,12 @@ pub mod assembly;
 pub mod benchmarks;
 pub mod discretisation;
 pub mod error;
+pub mod fabric_law;
 pub mod jet;
 pub mod kinematics;
 pub mod material;
 pub mod mls;
+pub mod moment;
 pub mod neighbours;
 pub mod problem;
 pub mod solve;
@@ -28,6 +31,7 @@ pub mod surface;
 
 pub use discretisation::Discretisation;
 pub use error::ShellError;
+pub use fabric_law::FabricLaw;
 pub use material::ShellMaterial;
 pub use mls::Basis;
 pub use problem::{Constraint, Direction, ShellParameters, ShellProblem};

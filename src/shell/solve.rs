@@ -85,13 +85,7 @@ pub fn solve_static(
     }
     let p = disc.params;
     // the residual at rest under the full load is minus the load vector
-    let f_norm = disc
-        .terms
-        .iter()
-        .map(|t| t.load.iter().map(|x| x * x).sum::<f64>())
-        .sum::<f64>()
-        .sqrt()
-        .max(f64::MIN_POSITIVE);
+    let f_norm = disc.external_load_norm().max(f64::MIN_POSITIVE);
     let mut report = SolveReport::default();
     let mut symbolic = None;
     for s in 1..=p.load_steps {
