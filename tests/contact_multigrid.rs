@@ -6,7 +6,7 @@ use emilion::cloth::{PreconditionerKind, Simulation, SimulationParameters};
 use emilion::contact::{Body, SimulationContact};
 use emilion::geometry::Vec3;
 
-/// Asks for the Galerkin coarse operators (`EMILION_MG_CONTACT=galerkin`, the default), which every
+/// Asks for the Galerkin coarse operators (`EMILION_MG_CONTACT=galerkin`, opt-in), which every
 /// test here checks; no test in this file wants another value.
 fn galerkin() {
     // every test of this file sets the same value, so the parallel tests never disagree

@@ -339,7 +339,7 @@ impl Multigrid {
     /// (contacts) enter each level's operator as stiff penalty springs κ n nᵀ, so that the
     /// V-cycle approximates the inverse of the constrained system rather than the free one.
     /// While any particle is in contact the coarse levels are instead Galerkin products of
-    /// the level above (with [`ContactCoarsening::Galerkin`], the default), which carry every
+    /// the level above (with [`ContactCoarsening::Galerkin`], opt-in), which carry every
     /// constraint down exactly.
     pub fn setup(
         &mut self,
