@@ -275,11 +275,8 @@ impl Collisions {
             if matches!(filter.kind[i], ParticleFilter::Fixed { .. }) {
                 continue;
             }
-            // end exactly at the thickness, never pushing out faster than max_push; a vertex
-            // caught above the thickness is not drawn in faster than it already approaches
-            let vn = ((h - p.distance) / dt)
-                .max(v[i].dot(&p.normal))
-                .min(p.velocity.dot(&p.normal) + max_push);
+            // end exactly at the thickness, never pushing out faster than max_push
+            let vn = ((h - p.distance) / dt).min(p.velocity.dot(&p.normal) + max_push);
             let stuck = self.stuck[i] && self.last_impulse[i] > 0.0;
             if stuck {
                 // static friction inside the solve: the particle moves with the surface
@@ -385,11 +382,7 @@ impl Collisions {
                 continue;
             }
             let jn = s.normal.dot(&impulse[i]);
-            // a held particle's impulse is what fixing all three directions took: if its
-            // normal part pulled, the particle slides on the next step (a normal constraint)
-            // and lets go only if that contact pulls too (else a rim vertex cycles held →
-            // released → thrown in at up to 0.05 m/s → held, issue 53)
-            self.last_impulse[i] = if s.stuck { jn.max(0.0) } else { jn };
+            self.last_impulse[i] = jn;
             if jn <= 0.0 {
                 self.stuck[i] = false;
                 self.slip[i] = Vec3::zeros();
