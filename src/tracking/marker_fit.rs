@@ -14,11 +14,10 @@
 use nalgebra::{DMatrix, DVector, Point3};
 
 use super::marker_set::MarkerSet;
+use super::puppet::fit::PUPPET_DAMPING;
 use super::puppet::{Proportions, Puppet, DRIVEN_BONES, PARAM_COUNT};
 use crate::body::{Mannequin, MarkerTrial, Pose};
-use crate::geometry::least_squares::{
-    self, BoundedDifferences, DampingUpdate, DiagonalDamping, LeastSquares, Schedule, Tries,
-};
+use crate::geometry::least_squares::{self, BoundedDifferences, LeastSquares, Schedule, Tries};
 use crate::geometry::Vec3;
 
 /// Pull (metres per radian, metres per metre) of every parameter toward its start: keeps
@@ -462,16 +461,7 @@ fn solve_frame(
     };
     let schedule = Schedule {
         iterations,
-        damping: (
-            1e-3,
-            DiagonalDamping::Shifted { floor: 1e-6 },
-            DampingUpdate::Factors {
-                down: 3.0,
-                min: 1e-9,
-                up: 4.0,
-                singular: 4.0,
-            },
-        ),
+        damping: PUPPET_DAMPING,
         tries: Tries::Count(10),
         progress: |old, new| old - new > 1e-10 * old.max(1e-12),
     };

@@ -35,7 +35,7 @@ use crate::body::{Mannequin, Pose, SkinWeights};
 use crate::geometry::Vec3;
 
 #[path = "puppet_fit.rs"]
-mod fit;
+pub(crate) mod fit;
 #[path = "puppet_rest.rs"]
 mod rest;
 

@@ -12,6 +12,19 @@ use crate::geometry::least_squares::{
 use crate::geometry::Vec3;
 use crate::tracking::joints::JOINT_COUNT;
 
+/// The damping of the puppet's Levenberg–Marquardt fits (the joint fit and the marker fit):
+/// initial λ, the shifted diagonal, and λ ÷3 after an accepted step, ×4 after a rejected one.
+pub(crate) const PUPPET_DAMPING: (f64, DiagonalDamping, DampingUpdate) = (
+    1e-3,
+    DiagonalDamping::Shifted { floor: 1e-6 },
+    DampingUpdate::Factors {
+        down: 3.0,
+        min: 1e-9,
+        up: 4.0,
+        singular: 4.0,
+    },
+);
+
 /// Tracking joints used to place the trunk first: pelvis, spine, neck, shoulders, hips.
 const TRUNK: [usize; 7] = [0, 1, 2, 4, 7, 10, 13];
 
@@ -149,16 +162,7 @@ impl Puppet {
         };
         let schedule = Schedule {
             iterations,
-            damping: (
-                1e-3,
-                DiagonalDamping::Shifted { floor: 1e-6 },
-                DampingUpdate::Factors {
-                    down: 3.0,
-                    min: 1e-9,
-                    up: 4.0,
-                    singular: 4.0,
-                },
-            ),
+            damping: PUPPET_DAMPING,
             tries: Tries::Count(12),
             // on the full squared norm 2·cost (exact doubling): a gain above 1e-14 of it
             progress: |old, new| 2.0 * (old - new) > 1e-14 * (2.0 * old).max(1e-12),
