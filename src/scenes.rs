@@ -1,6 +1,8 @@
 //! Built-in scenes: the benchmark's hanging cloth (identical to the Blender peer scene) and the
 //! demo scene that `emilion` runs with no arguments.
 
+pub mod sampling;
+
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 

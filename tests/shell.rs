@@ -179,3 +179,119 @@ fn kes_tensile_and_bending_rigs_on_the_shell_give_back_measured_curves_within_th
         }
     }
 }
+
+/// The overdamped relaxation (`shell::relax`) finds the same equilibrium as Newton's static
+/// solve: the heavy cantilever at q L³/B = 10 (a large rotation, 60°) against the elastica table,
+/// now with a mass so that the inertia term acts.
+#[test]
+fn relaxation_reaches_the_elastica_of_the_heavy_cantilever_within_one_degree() {
+    use emilion::shell::problem::{Constraint, Direction};
+    use emilion::shell::relax::{relax, RelaxParameters};
+    let (l, b, t) = (1.0, 0.1, 0.01);
+    let e = 12.0 / (t * t * t); // B = E t³/12 = 1 N·m
+    let (lam, reference) = ELASTICA_TIP_ANGLES[4];
+    assert_eq!(lam, 10.0);
+    let domain = [0.0, l, 0.0, b];
+    let fixed = |v: [f64; 3]| Direction::Fixed(v);
+    let problem = ShellProblem {
+        surface: Surface::Plane,
+        domain,
+        nodes: grid_nodes(domain, 21, 3),
+        material: ShellMaterial::isotropic(e, 0.0, t, 1.0).unwrap(),
+        edges: [
+            vec![
+                Constraint::Value(fixed([1.0, 0.0, 0.0])),
+                Constraint::Value(fixed([0.0, 1.0, 0.0])),
+                Constraint::Value(fixed([0.0, 0.0, 1.0])),
+                Constraint::Slope(Direction::Normal),
+            ],
+            vec![],
+            vec![],
+            vec![],
+        ],
+        pins: vec![],
+        area_load: [0.0, 0.0, -lam / (l * l * l)],
+        point_loads: vec![],
+    };
+    let disc = Discretisation::new(problem, ShellParameters::default()).unwrap();
+    let mut u = Vec::new();
+    let report = relax(
+        &disc,
+        None,
+        &mut u,
+        &RelaxParameters::default(),
+        &mut |_, _| {},
+    )
+    .unwrap();
+    let f = disc.field_at([l, 0.5 * b], &u).unwrap();
+    let a1 = nalgebra::Vector3::x() + f[1];
+    let angle = (-a1.z).atan2(a1.x).to_degrees();
+    println!("{report:?} tip angle {angle:.3}° (elastica {reference}°)");
+    assert!(
+        report.steps > 1,
+        "the inertia term took no effect: {report:?}"
+    );
+    assert!((angle - reference).abs() < 1.0, "{angle} vs {reference}");
+}
+
+/// Contact with a sphere by penalty: a square of cloth resting on a sphere so large that it is a
+/// floor (R = 100 m) sinks uniformly by its weight over the penalty stiffness, ρ g / k, and its
+/// shadow is its own area (the display surface and `render::shadow`).
+#[test]
+fn cloth_on_a_sphere_sinks_by_its_weight_over_the_penalty_stiffness() {
+    use emilion::render::shadow::shadow_area;
+    use emilion::shell::display::DisplaySurface;
+    use emilion::shell::obstacle::SphereObstacle;
+    use emilion::shell::relax::{relax, RelaxParameters};
+    let fabric = emilion::cloth::FabricParameters::default();
+    let rho_g = 9.81 * fabric.density;
+    let domain = [-0.1, 0.1, -0.1, 0.1];
+    let problem = ShellProblem {
+        surface: Surface::Plane,
+        domain,
+        nodes: grid_nodes(domain, 9, 9),
+        material: ShellMaterial::from_fabric(&fabric).unwrap(),
+        edges: Default::default(),
+        // the rigid motions in the floor's plane held at the centre and at one side
+        pins: vec![
+            ([0.0, 0.0], [1.0, 0.0, 0.0]),
+            ([0.0, 0.0], [0.0, 1.0, 0.0]),
+            ([0.1, 0.0], [0.0, 1.0, 0.0]),
+        ],
+        area_load: [0.0, 0.0, -rho_g],
+        point_loads: vec![],
+    };
+    let disc = Discretisation::new(problem, ShellParameters::default()).unwrap();
+    let radius = 100.0;
+    let obstacle = SphereObstacle {
+        centre: [0.0, 0.0, -radius - 0.002],
+        radius,
+        distance: 0.002,
+        stiffness: 1e4 * rho_g,
+    };
+    let mut u = Vec::new();
+    relax(
+        &disc,
+        Some(&obstacle),
+        &mut u,
+        &RelaxParameters::default(),
+        &mut |_, _| {},
+    )
+    .unwrap();
+    let expected = rho_g / obstacle.stiffness; // 1e-4 m
+    for p in [[0.0, 0.0], [0.1, 0.1], [-0.07, 0.03]] {
+        let w = disc.displacement_at(p, &u).unwrap();
+        // the sphere's own drop over 0.14 m at R = 100 m is 0.1 mm × 0.98: measured from it
+        let r2 = p[0] * p[0] + p[1] * p[1];
+        let sink = -w.z - r2 / (2.0 * (radius + 0.002));
+        println!(
+            "{p:?}: sink {sink:.4e} m (ρg/k {expected:.4e} m), in-plane {:.2e} m",
+            w.x.hypot(w.y)
+        );
+        assert!((sink / expected - 1.0).abs() < 0.02, "{sink} vs {expected}");
+    }
+    assert!((obstacle.max_penetration(&disc, &u) / expected - 1.0).abs() < 0.02);
+    let s = DisplaySurface::new(&disc, &u, 41, 41).unwrap();
+    let a = shadow_area(&s.positions, &s.triangles, 2e-4).unwrap();
+    assert!((a / 0.04 - 1.0).abs() < 0.01, "shadow {a} m² vs 0.04 m²");
+}

@@ -6,12 +6,14 @@
 //! - [`raster`]: the z-buffered vertex-colour rasterizer (depth and interpolated colours or
 //!   texture coordinates) that the body tracker, its synthetic sequences and the face code
 //!   draw through a calibrated [`Camera`](crate::geometry::Camera);
-//! - [`plot`]: line plots.
+//! - [`plot`]: line plots;
+//! - [`shadow`]: the area of a mesh's shadow on the ground (a drape coefficient's measure).
 
 pub mod picture;
 pub mod plot;
 pub mod raster;
 mod shading;
+pub mod shadow;
 
 pub use picture::{render, render_png, RenderMesh};
 pub use plot::{

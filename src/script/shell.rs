@@ -1,5 +1,6 @@
 //! Script bindings of the meshless Kirchhoff–Love shell: its benchmark cases (the work lives in
-//! `crate::shell::benchmarks`) and the KES rigs on it (`crate::kes::shell_rigs`).
+//! `crate::shell::benchmarks`), the KES rigs on it (`crate::kes::shell_rigs`) and the
+//! sampling-independence study against the mass-spring cloth (`crate::scenes::sampling`).
 
 use rhai::{Array, Dynamic, Map, INT};
 
@@ -50,8 +51,47 @@ fn result_map(r: &BenchmarkResult) -> Map {
     m
 }
 
+/// One run of the sampling study (`shell::sampling_run`).
+fn sampling_run(f: &super::kes::KesFabric, scene: &str, model: &str, n: INT) -> RResult<Map> {
+    use crate::scenes::sampling::{linear_fabric, mass_spring_run, shell_run, Scene};
+    let scene = match scene {
+        "drape" => Scene::Drape,
+        "hang" => Scene::Hang,
+        other => {
+            return Err(rt_err(format!(
+                "shell::sampling_run: scene must be \"drape\" or \"hang\", got {other:?}"
+            )))
+        }
+    };
+    let n = usize::try_from(n).map_err(|_| rt_err(format!("shell::sampling_run: n = {n}")))?;
+    let (params, law) = crate::kes::lab::measured_fabric(&f.0).map_err(rt_err)?;
+    let fabric = linear_fabric(std::sync::Arc::new(law), params.density).map_err(rt_err)?;
+    let row = match model {
+        "shell" => shell_run(scene, n, &fabric, &Default::default()),
+        "mass-spring" => mass_spring_run(scene, n, &fabric, 60.0),
+        other => Err(format!(
+            "shell::sampling_run: model must be \"shell\" or \"mass-spring\", got {other:?}"
+        )),
+    }
+    .map_err(rt_err)?;
+    let mut m = Map::new();
+    m.insert("model".into(), Dynamic::from(row.model.to_string()));
+    m.insert("scene".into(), Dynamic::from(row.scene.name().to_string()));
+    m.insert("per_side".into(), Dynamic::from_int(row.per_side as INT));
+    m.insert("spacing".into(), Dynamic::from_float(row.spacing));
+    m.insert("value".into(), Dynamic::from_float(row.value));
+    m.insert("steps".into(), Dynamic::from_int(row.steps as INT));
+    m.insert("seconds".into(), Dynamic::from_float(row.seconds));
+    Ok(m)
+}
+
 /// Registers the shell functions.
 pub fn register(engine: &mut ApiBuilder) {
+    function!(engine, "shell::sampling_run", ["fabric: KesFabric", "scene: String", "model: String", "n: int", "Map"],
+        "One run of the sampling-independence study (docs/shell.md): a 1 m square of the fabric's\nlinear law (initial slopes of its measured law) on `n` × `n` points (odd, 5 to 201), `scene`\n\"drape\" (over a 0.3 m sphere, centre held: the drape coefficient) or \"hang\" (from the\ntop corners: the sag of the top edge's middle, m), `model` \"shell\" (relaxed to\nequilibrium) or \"mass-spring\" (run until still). Returns #{model, scene, per_side,\nspacing (m), value, steps (Newton iterations or time steps), seconds}.",
+        |f: super::kes::KesFabric, scene: &str, model: &str, n: INT| -> RResult<Map> {
+            sampling_run(&f, scene, model, n)
+        });
     function!(engine, "shell::kes_rigs", ["fabric: KesFabric", "options: Map", "Map"],
         "Runs the KES-FB1 tensile and KES-FB2 pure-bending rigs on the meshless shell with the\nfabric's measured law (elastic backbone), for every measured tensile and bending curve the\nfabric has, and compares each loading path with the measured loading branch. Options:\n`points_along` (11), `tensile_steps` (20), `bending_steps` (15). Returns #{name,\nworst_rms_pct, rows: [#{test, rms_pct (% of the measured range), max_x (strain or 1/m)}]}.",
         |f: super::kes::KesFabric, options: Map| -> RResult<Map> {

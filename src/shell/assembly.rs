@@ -14,6 +14,9 @@ use super::jet::NV;
 use super::kinematics::{energy_density_law, rest_locals};
 use super::moment::{add_moment_residual, add_moment_tangent};
 
+/// One entry of the tangent (row, column, value).
+pub type Entry = Triplet<usize, usize, f64>;
+
 /// The weighted gradient and Hessian of the energy at one background point.
 type PointJet = ([f64; NV], Box<[[f64; NV]; NV]>);
 
@@ -143,6 +146,18 @@ pub fn residual_and_tangent(
     u: &[f64],
     lambda: f64,
 ) -> Result<(Vec<f64>, SparseColMat<usize, f64>), ShellError> {
+    let (res, trip) = residual_and_triplets(disc, u, lambda)?;
+    Ok((res, tangent_matrix(disc, &trip)?))
+}
+
+/// The residual and the tangent's entries (duplicates summed by [`tangent_matrix`]), for
+/// callers that add terms of their own (contact, inertia) before the matrix is built. Every
+/// node's columns appear, zeros included, so the pattern does not depend on `u`.
+pub fn residual_and_triplets(
+    disc: &Discretisation,
+    u: &[f64],
+    lambda: f64,
+) -> Result<(Vec<f64>, Vec<Entry>), ShellError> {
     let jets = point_jets(disc, u, true);
     let rows: Vec<([f64; 3], Vec<[f64; 9]>)> = disc
         .terms
@@ -166,7 +181,15 @@ pub fn residual_and_tangent(
     }
     add_moment_residual(&disc.moments, u, lambda, &mut res);
     add_moment_tangent(&disc.moments, u, lambda, &mut trip);
-    let mat = SparseColMat::try_new_from_triplets(n, n, &trip)
-        .map_err(|e| ShellError::Solver(format!("tangent matrix: {e:?}")))?;
-    Ok((res, mat))
+    Ok((res, trip))
+}
+
+/// The tangent matrix from its entries (duplicates summed).
+pub fn tangent_matrix(
+    disc: &Discretisation,
+    trip: &[Entry],
+) -> Result<SparseColMat<usize, f64>, ShellError> {
+    let n = 3 * disc.len();
+    SparseColMat::try_new_from_triplets(n, n, trip)
+        .map_err(|e| ShellError::Solver(format!("tangent matrix: {e:?}")))
 }

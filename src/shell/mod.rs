@@ -12,11 +12,14 @@
 //! energy density, [`material`] the linear laws, [`fabric_law`] a fabric's
 //! measured (nonlinear) law, [`moment`] edge moments, [`problem`] problems and parameters,
 //! [`discretisation`] background cells and quadrature, [`assembly`] residual and tangent,
-//! [`solve`] Newton, [`benchmarks`] the shell obstacle course.
+//! [`solve`] Newton, [`relax`] relaxation to a stable equilibrium (overdamped implicit steps),
+//! [`obstacle`] contact with a sphere, [`display`] the triangulated display surface,
+//! [`benchmarks`] the shell obstacle course.
 
 pub mod assembly;
 pub mod benchmarks;
 pub mod discretisation;
+pub mod display;
 pub mod error;
 pub mod fabric_law;
 pub mod jet;
@@ -25,7 +28,9 @@ pub mod material;
 pub mod mls;
 pub mod moment;
 pub mod neighbours;
+pub mod obstacle;
 pub mod problem;
+pub mod relax;
 pub mod solve;
 pub mod surface;
 

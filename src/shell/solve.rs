@@ -31,7 +31,7 @@ fn norm(v: &[f64]) -> f64 {
 /// One Newton update u += −K⁻¹ r from the residual `r` and tangent `k` at `u`; `symbolic` is
 /// the tangent's symbolic LU, computed on the first call and reused after (the pattern does
 /// not change).
-fn newton_update(
+pub(crate) fn newton_update(
     r: &[f64],
     k: &SparseColMat<usize, f64>,
     u: &mut [f64],
