@@ -9,16 +9,15 @@
 
 use std::time::Instant;
 
-use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt, SymbolicLu};
 use faer::sparse::{SparseColMat, Triplet};
-use faer::{Col, Side};
+use faer::Side;
 
 use super::assembly::{residual_and_triplets, tangent_matrix};
 use super::discretisation::Discretisation;
 use super::error::ShellError;
 use super::obstacle::SphereObstacle;
-use super::solve::newton_update;
+use super::solve::{apply_update, newton_update};
 use crate::limits;
 
 /// How a relaxation proceeds.
@@ -101,19 +100,7 @@ fn newton_step(
     }
     let sym = symbolic.llt.clone().expect("set above");
     match Llt::try_new_with_symbolic(sym, k.as_ref(), Side::Lower) {
-        Ok(llt) => {
-            let rhs = Col::<f64>::from_fn(r.len(), |i| -r[i]);
-            let du = llt.solve(&rhs);
-            for (i, x) in u.iter_mut().enumerate() {
-                if !du[i].is_finite() {
-                    return Err(ShellError::Solver(
-                        "the tangent is singular (a rigid-body motion left free?)".into(),
-                    ));
-                }
-                *x += du[i];
-            }
-            Ok(())
-        }
+        Ok(llt) => apply_update(&llt, r, u).map(|_| ()),
         Err(_) => newton_update(r, k, u, &mut symbolic.lu).map(|_| ()),
     }
 }

@@ -45,17 +45,26 @@ pub(crate) fn newton_update(
     let sym = symbolic.clone().expect("set above");
     let lu = Lu::try_new_with_symbolic(sym, k.as_ref())
         .map_err(|e| ShellError::Solver(format!("sparse LU of the tangent failed: {e:?}")))?;
+    apply_update(&lu, r, u)
+}
+
+/// u += −K⁻¹ r with a factorisation of K; the largest |Δu|. A non-finite update (a singular
+/// tangent) is an error and leaves `u` unchanged.
+pub(crate) fn apply_update(
+    factor: &impl Solve<f64>,
+    r: &[f64],
+    u: &mut [f64],
+) -> Result<f64, ShellError> {
     let rhs = Col::<f64>::from_fn(r.len(), |i| -r[i]);
-    let du = lu.solve(&rhs);
+    let du = factor.solve(&rhs);
+    if !(0..u.len()).all(|i| du[i].is_finite()) {
+        return Err(ShellError::Solver(
+            "the tangent is singular (a rigid-body motion left free? add supports or pins)".into(),
+        ));
+    }
     let mut step = 0.0f64;
-    for i in 0..u.len() {
-        if !du[i].is_finite() {
-            return Err(ShellError::Solver(
-                "the tangent is singular (a rigid-body motion left free? add supports or pins)"
-                    .into(),
-            ));
-        }
-        u[i] += du[i];
+    for (i, x) in u.iter_mut().enumerate() {
+        *x += du[i];
         step = step.max(du[i].abs());
     }
     Ok(step)
