@@ -72,6 +72,9 @@ pub struct SamplingRow {
     pub steps: usize,
     /// Wall time (s).
     pub seconds: f64,
+    /// Whether it reached equilibrium (the shell always does or errs; the mass-spring cloth
+    /// may still move when its time runs out, and then its last value is reported).
+    pub settled: bool,
 }
 
 /// The linear fabric of a measured law's initial slopes (or secants to 1 % strain, 0.01 rad
@@ -193,11 +196,13 @@ pub fn shell_run(
         value,
         steps: report.newton_iterations,
         seconds: t0.elapsed().as_secs_f64(),
+        settled: true,
     })
 }
 
 /// The mass-spring cloth's answer on an `n` × `n` grid (odd `n`), run at Δt = 1/120 s until its
-/// mean speed is under 0.1 mm/s (checked every 0.25 s) or `max_seconds` have passed (an error).
+/// mean speed is under 0.1 mm/s (checked every 0.25 s) or `max_seconds` have passed (then
+/// reported as not settled, with its last value).
 pub fn mass_spring_run(
     scene: Scene,
     n: usize,
@@ -262,6 +267,7 @@ pub fn mass_spring_run(
     let check = 30;
     let mut steps = 0;
     let mut history: Vec<f64> = Vec::new();
+    let mut settled = true;
     let value = loop {
         let mut kinetic = 0.0;
         for _ in 0..check {
@@ -278,10 +284,8 @@ pub fn mass_spring_run(
             break v;
         }
         if steps as f64 / 120.0 >= max_seconds {
-            return Err(format!(
-                "mass-spring {} at {n} per side still moves after {max_seconds} s (mean speed {speed:.2e} m/s)",
-                scene.name()
-            ));
+            settled = false;
+            break v;
         }
     };
     Ok(SamplingRow {
@@ -292,5 +296,6 @@ pub fn mass_spring_run(
         value,
         steps,
         seconds: t0.elapsed().as_secs_f64(),
+        settled,
     })
 }
