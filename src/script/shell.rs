@@ -53,7 +53,9 @@ fn result_map(r: &BenchmarkResult) -> Map {
 
 /// One run of the sampling study (`shell::sampling_run`).
 fn sampling_run(f: &super::kes::KesFabric, scene: &str, model: &str, n: INT) -> RResult<Map> {
-    use crate::scenes::sampling::{linear_fabric, mass_spring_run, shell_run, Scene};
+    use crate::scenes::sampling::{
+        linear_fabric, mass_spring_run, shell_run, study_shell_parameters, Scene,
+    };
     let scene = match scene {
         "drape" => Scene::Drape,
         "hang" => Scene::Hang,
@@ -67,7 +69,13 @@ fn sampling_run(f: &super::kes::KesFabric, scene: &str, model: &str, n: INT) -> 
     let (params, law) = crate::kes::lab::measured_fabric(&f.0).map_err(rt_err)?;
     let fabric = linear_fabric(std::sync::Arc::new(law), params.density).map_err(rt_err)?;
     let row = match model {
-        "shell" => shell_run(scene, n, &fabric, &Default::default()),
+        "shell" => shell_run(
+            scene,
+            n,
+            &fabric,
+            study_shell_parameters(),
+            &Default::default(),
+        ),
         "mass-spring" => mass_spring_run(scene, n, &fabric, 60.0),
         other => Err(format!(
             "shell::sampling_run: model must be \"shell\" or \"mass-spring\", got {other:?}"
