@@ -270,7 +270,7 @@ fn cloth_on_a_sphere_sinks_by_its_weight_over_the_penalty_stiffness() {
         stiffness: 1e4 * rho_g,
     };
     let mut u = Vec::new();
-    relax(
+    let report = relax(
         &disc,
         Some(&obstacle),
         &mut u,
@@ -278,6 +278,7 @@ fn cloth_on_a_sphere_sinks_by_its_weight_over_the_penalty_stiffness() {
         &mut |_, _| {},
     )
     .unwrap();
+    println!("{report:?}");
     let expected = rho_g / obstacle.stiffness; // 1e-4 m
     for p in [[0.0, 0.0], [0.1, 0.1], [-0.07, 0.03]] {
         let w = disc.displacement_at(p, &u).unwrap();

@@ -7,7 +7,9 @@
 //! pattern already holds.
 
 use faer::sparse::Triplet;
+use rayon::prelude::*;
 
+use super::assembly::Entry;
 use super::discretisation::{Discretisation, QuadPoint};
 use super::error::ShellError;
 use super::surface::V3;
@@ -65,51 +67,84 @@ impl SphereObstacle {
         (g > 0.0 && d > 1e-12 * self.radius).then(|| (g, r / d, d))
     }
 
-    /// Adds the penalty's residual to `res` (3 per node) and, with `trip`, its tangent.
+    /// Adds the penalty's residual to `res` (3 per node) and, with `trip`, its tangent: one
+    /// 3×3 block per node pair that shares a point in contact, summed per node row (in
+    /// parallel, joined in node order) so that a cloth lying on the sphere does not produce
+    /// a triplet per point and pair.
     pub fn add_terms(
         &self,
         disc: &Discretisation,
         u: &[f64],
         res: &mut [f64],
-        mut trip: Option<&mut Vec<Triplet<usize, usize, f64>>>,
+        trip: Option<&mut Vec<Entry>>,
     ) {
-        for q in &disc.quad {
-            let x = Self::position(q, u);
-            let Some((g, n, d)) = self.penetration(&x) else {
-                continue;
-            };
-            let k = self.stiffness * q.weight;
-            // force on the mid-surface: −∂E/∂x = k g n; the residual is ∂E/∂u
-            let grad = n * (-k * g);
+        // per quadrature point: the weighted force gradient ∂E/∂x and Hessian ∂²E/∂x², where
+        // in contact
+        let local: Vec<Option<(V3, [f64; 9])>> = disc
+            .quad
+            .par_iter()
+            .map(|q| {
+                let (g, n, d) = self.penetration(&Self::position(q, u))?;
+                let k = self.stiffness * q.weight;
+                // ∂²E/∂x² = k n nᵀ − k g/d (I − n nᵀ)
+                let geo = k * g / d;
+                let mut h = [0.0; 9];
+                for a in 0..3 {
+                    for b in 0..3 {
+                        let eye = if a == b { 1.0 } else { 0.0 };
+                        h[3 * a + b] = k * n[a] * n[b] - geo * (eye - n[a] * n[b]);
+                    }
+                }
+                Some((n * (-k * g), h))
+            })
+            .collect();
+        for (q, l) in disc.quad.iter().zip(&local) {
+            let Some((grad, _)) = l else { continue };
             for (jj, &j) in q.nodes.iter().enumerate() {
                 let phi = q.values[jj][0];
                 for c in 0..3 {
                     res[3 * j + c] += phi * grad[c];
                 }
             }
-            let Some(trip) = trip.as_deref_mut() else {
-                continue;
-            };
-            // ∂²E/∂x² = k n nᵀ − k g/d (I − n nᵀ)
-            let geo = k * g / d;
-            let mut h = [0.0; 9];
-            for a in 0..3 {
-                for b in 0..3 {
-                    let eye = if a == b { 1.0 } else { 0.0 };
-                    h[3 * a + b] = k * n[a] * n[b] - geo * (eye - n[a] * n[b]);
-                }
-            }
-            for (ja, &j) in q.nodes.iter().enumerate() {
-                let pj = q.values[ja][0];
-                for (kb, &l) in q.nodes.iter().enumerate() {
-                    let s = pj * q.values[kb][0];
-                    for a in 0..3 {
-                        for b in 0..3 {
-                            trip.push(Triplet::new(3 * j + a, 3 * l + b, s * h[3 * a + b]));
+        }
+        let Some(trip) = trip else { return };
+        let rows: Vec<Vec<Entry>> = disc
+            .terms
+            .par_iter()
+            .enumerate()
+            .map(|(j, t)| {
+                let mut blocks: Vec<Option<[f64; 9]>> = vec![None; t.columns.len()];
+                for &(qi, a) in &t.quad {
+                    let Some((_, h)) = &local[qi] else { continue };
+                    let q = &disc.quad[qi];
+                    let pj = q.values[a][0];
+                    let mut slot = 0;
+                    for (kb, &l) in q.nodes.iter().enumerate() {
+                        while t.columns[slot] < l {
+                            slot += 1;
+                        }
+                        let s = pj * q.values[kb][0];
+                        let b = blocks[slot].get_or_insert([0.0; 9]);
+                        for e in 0..9 {
+                            b[e] += s * h[e];
                         }
                     }
                 }
-            }
+                let mut out = Vec::new();
+                for (slot, b) in blocks.iter().enumerate() {
+                    let Some(b) = b else { continue };
+                    let l = t.columns[slot];
+                    for a in 0..3 {
+                        for c in 0..3 {
+                            out.push(Triplet::new(3 * j + a, 3 * l + c, b[3 * a + c]));
+                        }
+                    }
+                }
+                out
+            })
+            .collect();
+        for r in rows {
+            trip.extend(r);
         }
     }
 
