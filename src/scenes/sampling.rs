@@ -42,6 +42,19 @@ pub enum Scene {
     Drape,
     /// From two corners: the sag of the top edge's middle (m).
     Hang,
+    /// From two clips ([`CLIP`] square at each top corner, every point inside held): the sag
+    /// of the top edge's middle (m). Unlike point pins, the support does not depend on the
+    /// sampling.
+    HangClips,
+}
+
+/// Side of the square clips of [`Scene::HangClips`] (m).
+pub const CLIP: f64 = 0.05;
+
+/// Whether a rest point (x, y in [−0.5, 0.5]²) lies in one of the two clips.
+fn in_clip(x: f64, y: f64) -> bool {
+    let e = 1e-9;
+    y >= 0.5 - CLIP - e && (x <= -0.5 + CLIP + e || x >= 0.5 - CLIP - e)
 }
 
 impl Scene {
@@ -50,6 +63,7 @@ impl Scene {
         match self {
             Scene::Drape => "drape",
             Scene::Hang => "hang",
+            Scene::HangClips => "hang_clips",
         }
     }
 }
@@ -151,6 +165,19 @@ pub fn shell_run(
             .iter()
             .flat_map(|d| [([-0.5, 0.5], *d), ([0.5, 0.5], *d)])
             .collect(),
+        // a fixed 6 × 6 lattice over each clip, whatever the sampling
+        Scene::HangClips => {
+            let mut pins = Vec::new();
+            for x0 in [-0.5, 0.5 - CLIP] {
+                for i in 0..6 {
+                    for j in 0..6 {
+                        let p = [x0 + CLIP * i as f64 / 5.0, 0.5 - CLIP * j as f64 / 5.0];
+                        pins.extend(all.iter().map(|d| (p, *d)));
+                    }
+                }
+            }
+            pins
+        }
     };
     let problem = ShellProblem {
         surface: crate::shell::Surface::Plane,
@@ -170,7 +197,9 @@ pub fn shell_run(
         let w = perturbation(p[0], p[1]);
         match scene {
             Scene::Drape => u.extend_from_slice(&[0.0, 0.0, w]),
-            Scene::Hang => u.extend_from_slice(&[0.0, 0.5 - p[1] + w, p[1] - 0.5]),
+            Scene::Hang | Scene::HangClips => {
+                u.extend_from_slice(&[0.0, 0.5 - p[1] + w, p[1] - 0.5])
+            }
         }
     }
     let obstacle = SphereObstacle {
@@ -188,7 +217,7 @@ pub fn shell_run(
             let s = DisplaySurface::new(&disc, &u, 201, 201).map_err(|e| e.to_string())?;
             drape_coefficient(&s.positions, &s.triangles)?
         }
-        Scene::Hang => {
+        Scene::Hang | Scene::HangClips => {
             -disc
                 .displacement_at([0.0, 0.5], &u)
                 .map_err(|e| e.to_string())?
@@ -227,7 +256,7 @@ pub fn mass_spring_run(
         let w = perturbation(p.x, p.y);
         *p = match scene {
             Scene::Drape => Vec3::new(p.x, p.y, w),
-            Scene::Hang => Vec3::new(p.x, w, p.y - 0.5),
+            Scene::Hang | Scene::HangClips => Vec3::new(p.x, w, p.y - 0.5),
         };
     }
     let sim_params = SimulationParameters {
@@ -256,6 +285,13 @@ pub fn mass_spring_run(
             sim.pin(&[(n - 1) * n, n * n - 1])
                 .map_err(|e| e.to_string())?;
         }
+        Scene::HangClips => {
+            let h = 1.0 / (n - 1) as f64;
+            let held: Vec<usize> = (0..n * n)
+                .filter(|&k| in_clip(-0.5 + (k % n) as f64 * h, -0.5 + (k / n) as f64 * h))
+                .collect();
+            sim.pin(&held).map_err(|e| e.to_string())?;
+        }
     }
     let mass: f64 = sim.model.mass.iter().sum();
     let measure = |sim: &Simulation| -> Result<f64, String> {
@@ -265,7 +301,7 @@ pub fn mass_spring_run(
                 let pos: Vec<[f64; 3]> = x.iter().map(|p| [p.x, p.y, p.z]).collect();
                 drape_coefficient(&pos, &sim.model.mesh.triangles)
             }
-            Scene::Hang => Ok(x[(n - 1) * n].z - x[(n - 1) * n + n / 2].z),
+            Scene::Hang | Scene::HangClips => Ok(x[(n - 1) * n].z - x[(n - 1) * n + n / 2].z),
         }
     };
     // settled: still (mean speed under 0.1 mm/s), or the measured value steady to 1e-4

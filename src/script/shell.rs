@@ -59,9 +59,10 @@ fn sampling_run(f: &super::kes::KesFabric, scene: &str, model: &str, n: INT) -> 
     let scene = match scene {
         "drape" => Scene::Drape,
         "hang" => Scene::Hang,
+        "hang_clips" => Scene::HangClips,
         other => {
             return Err(rt_err(format!(
-                "shell::sampling_run: scene must be \"drape\" or \"hang\", got {other:?}"
+                "shell::sampling_run: scene must be \"drape\", \"hang\" or \"hang_clips\", got {other:?}"
             )))
         }
     };
@@ -97,7 +98,7 @@ fn sampling_run(f: &super::kes::KesFabric, scene: &str, model: &str, n: INT) -> 
 /// Registers the shell functions.
 pub fn register(engine: &mut ApiBuilder) {
     function!(engine, "shell::sampling_run", ["fabric: KesFabric", "scene: String", "model: String", "n: int", "Map"],
-        "One run of the sampling-independence study (docs/shell.md): a 1 m square of the fabric's\nlinear law (initial slopes of its measured law) on `n` × `n` points (odd, 5 to 201), `scene`\n\"drape\" (over a 0.3 m sphere, centre held: the drape coefficient) or \"hang\" (from the\ntop corners: the sag of the top edge's middle, m), `model` \"shell\" (relaxed to\nequilibrium) or \"mass-spring\" (run until still). Returns #{model, scene, per_side,\nspacing (m), value, steps (Newton iterations or time steps), seconds, settled (false: the\nmass-spring cloth still moved after 60 s; its last value)}.",
+        "One run of the sampling-independence study (docs/shell.md): a 1 m square of the fabric's\nlinear law (initial slopes of its measured law) on `n` × `n` points (odd, 5 to 201), `scene`\n\"drape\" (over a 0.3 m sphere, centre held: the drape coefficient), \"hang\" (from the\ntop corners: the sag of the top edge's middle, m) or \"hang_clips\" (held by 5 cm square\nclips at the top corners), `model` \"shell\" (relaxed to\nequilibrium) or \"mass-spring\" (run until still). Returns #{model, scene, per_side,\nspacing (m), value, steps (Newton iterations or time steps), seconds, settled (false: the\nmass-spring cloth still moved after 60 s; its last value)}.",
         |f: super::kes::KesFabric, scene: &str, model: &str, n: INT| -> RResult<Map> {
             sampling_run(&f, scene, model, n)
         });
