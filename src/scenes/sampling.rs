@@ -58,7 +58,7 @@ fn in_clip(x: f64, y: f64) -> bool {
 }
 
 impl Scene {
-    /// "drape" or "hang".
+    /// "drape", "hang" or "hang_clips".
     pub fn name(self) -> &'static str {
         match self {
             Scene::Drape => "drape",
@@ -109,7 +109,7 @@ pub fn linear_fabric(law: Arc<dyn MaterialLaw>, density: f64) -> Result<FabricPa
 }
 
 /// The shared perturbation: a smooth millimetre-scale field of the rest position (x, y) in
-/// [−0.5, 0.5]², along `dir` (z for the drape, y for the hang).
+/// [−0.5, 0.5]², applied out of the cloth's plane (z for the drape, y for the hangs).
 fn perturbation(x: f64, y: f64) -> f64 {
     let r2 = x * x + y * y;
     1e-3 * r2 * (3.0 * y.atan2(x) + 0.4).sin() + 2e-4 * (2.1 * x + 1.3 * y).sin()

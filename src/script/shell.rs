@@ -66,7 +66,11 @@ fn sampling_run(f: &super::kes::KesFabric, scene: &str, model: &str, n: INT) -> 
             )))
         }
     };
-    let n = usize::try_from(n).map_err(|_| rt_err(format!("shell::sampling_run: n = {n}")))?;
+    let n = usize::try_from(n).map_err(|_| {
+        rt_err(format!(
+            "shell::sampling_run: `n` (points per side) must be odd and lie in [5, 201], got {n}"
+        ))
+    })?;
     let (params, law) = crate::kes::lab::measured_fabric(&f.0).map_err(rt_err)?;
     let fabric = linear_fabric(std::sync::Arc::new(law), params.density).map_err(rt_err)?;
     let row = match model {

@@ -1,6 +1,6 @@
 //! Relaxation to a stable equilibrium: overdamped implicit steps (backward Euler with the
 //! velocity dropped after every step), each solving M (u − u₀)/Δt² + R(u) = 0 by Newton with
-//! `faer`'s sparse LU, M the lumped mass (ρ ∫ φ_J dA per node). A converged equilibrium of the
+//! `faer`'s sparse Cholesky (LU where the tangent is not positive definite), M the lumped mass (ρ ∫ φ_J dA per node). A converged equilibrium of the
 //! static problem is reached when the static residual |R(u)| (contact included) falls under the
 //! tolerance. Unlike Newton on R alone, the inertia term makes every step a descent of the
 //! energy, so a drape that must buckle into folds leaves the symmetric (unstable) equilibrium
@@ -13,7 +13,7 @@ use faer::sparse::linalg::solvers::{Llt, SymbolicLlt, SymbolicLu};
 use faer::sparse::{SparseColMat, Triplet};
 use faer::Side;
 
-use super::assembly::{residual_and_triplets, tangent_matrix};
+use super::assembly::{residual_and_triplets, tangent_matrix, Entry};
 use super::discretisation::Discretisation;
 use super::error::ShellError;
 use super::obstacle::SphereObstacle;
@@ -139,22 +139,33 @@ pub fn relax(
     let mut symbolic = Symbolic::default();
     let mut dt = params.dt;
     let mut start = u.clone();
+    // the static residual and tangent entries of the state the last accepted step ended on
+    let mut assembled: Option<(Vec<f64>, Vec<Entry>)> = None;
     while report.steps + report.rejected < params.max_steps {
         limits::check_cancelled().map_err(ShellError::Solver)?;
         let inertia = 1.0 / (dt * dt);
         let mut converged = None;
         let mut first = f64::INFINITY;
         for it in 0..=params.newton_iterations {
-            let (mut res, mut trip) = residual_and_triplets(disc, u, 1.0)?;
-            if let Some(o) = obstacle {
-                o.add_terms(disc, u, &mut res, Some(&mut trip));
-            }
+            // the state a converged step ended on was assembled there: not again here
+            let (mut res, mut trip) = match assembled.take() {
+                Some(a) => a,
+                None => {
+                    let (mut res, mut trip) = residual_and_triplets(disc, u, 1.0)?;
+                    if let Some(o) = obstacle {
+                        o.add_terms(disc, u, &mut res, Some(&mut trip));
+                    }
+                    (res, trip)
+                }
+            };
             let static_r = norm(&res) / f_norm;
             if it == 0 && static_r <= params.tolerance {
                 report.residual = static_r;
                 report.seconds = t0.elapsed().as_secs_f64();
                 return Ok(report);
             }
+            let static_res = res.clone();
+            let static_len = trip.len();
             for (j, &m) in mass.iter().enumerate() {
                 for c in 0..3 {
                     let i = 3 * j + c;
@@ -169,6 +180,8 @@ pub fn relax(
             // the step's own system solved well below where the static residual stands
             if step_r <= 0.1 * params.tolerance || (it > 0 && step_r <= 1e-4 * first) {
                 converged = Some(it);
+                trip.truncate(static_len);
+                assembled = Some((static_res, trip));
                 break;
             }
             if it == params.newton_iterations {
