@@ -98,7 +98,7 @@ fn other_scripts_run() {
         let name = p.file_stem().unwrap().to_str().unwrap().to_string();
         // the contact scripts run in tests/contact_scripts.rs, the garments in
         // tests/garment_scripts.rs, the buckle_* scripts in tests/buckling.rs and the tracking
-        // scripts in tests/tracking_track.rs, the face scripts in tests/face_track.rs and tests/face_fit.rs,
+        // scripts in tests/tracking_track.rs (golf: tests/golf_sequence.rs), the face scripts in tests/face_track.rs and tests/face_fit.rs,
         // with their checks; facade_train (minutes on its defaults) in tests/facade_learned.rs
         // on a few photos
         if [
@@ -119,6 +119,8 @@ fn other_scripts_run() {
             "make_sequence",
             "track_body",
             "golf_markers",
+            "golf_sequence",
+            "golf_track",
             "make_face_sequence",
             "face_track",
             "face_fit",

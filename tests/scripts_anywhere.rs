@@ -35,6 +35,17 @@ const QUICK: &[(&str, &[&str])] = &[
     ("make_face_sequence", &["frames=2", "cameras=1"]),
     ("face_track", &["frames=2"]),
     ("track_body", &["frames=2"]),
+    (
+        "golf_sequence",
+        &[
+            "frames=2",
+            "every=12",
+            "width=160",
+            "height=120",
+            "cameras=1",
+        ],
+    ),
+    ("golf_track", &["frames=2"]),
     ("facades_eval", &["limit=2"]),
     ("all", &["meshes=coarse", "limit=1"]),
     ("bending", &["meshes=coarse"]),

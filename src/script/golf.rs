@@ -3,13 +3,16 @@
 use rhai::{Dynamic, Map, INT};
 
 use super::convert::{rt_err, RResult};
-use super::paths::{read_folder_opt, write_folder};
-use super::tracking_sequence::whole;
+use super::paths::{read_folder, read_folder_opt, write_folder};
+use super::tracking_sequence::{apply_options, number, whole};
 use super::{function, modules::ApiBuilder};
 use crate::body::Mannequin;
 use crate::geometry::files::data_path;
+use crate::tracking::golf_sequence::{make_golf_sequence, GolfSequenceOptions};
+use crate::tracking::golf_track::golf_report;
 use crate::tracking::golf_trial::run_golf_trial;
 use crate::tracking::marker_fit::MarkerFitOptions;
+use crate::tracking::sequence_files::Sequence;
 
 fn golf(c3d: &str, out: &str, m: &Map) -> RResult<Map> {
     if !std::path::Path::new(c3d).is_file() {
@@ -67,6 +70,110 @@ fn golf(c3d: &str, out: &str, m: &Map) -> RResult<Map> {
     Ok(map)
 }
 
+/// Option keys of `track::golf_sequence` besides the sequence's own.
+const GOLF_KEYS: [&str; 6] = ["shutter", "blur", "reshape", "every", "stride", "rounds"];
+
+fn golf_sequence(c3d: &str, out: &str, m: &Map) -> RResult<Map> {
+    if !std::path::Path::new(c3d).is_file() {
+        let mut map = Map::new();
+        map.insert("skipped".into(), format!("{c3d} is absent").into());
+        return Ok(map);
+    }
+    if m.contains_key("lbs") {
+        return Err(rt_err(
+            "golf_sequence: `lbs` does not apply (the golfer is always skinned by linear blending)",
+        ));
+    }
+    let mut o = GolfSequenceOptions::default();
+    apply_options(&mut o.sequence, m, "golf_sequence", &GOLF_KEYS)?;
+    let get = |k: &str| m.get(k).map(|d| number(d, k)).transpose();
+    if let Some(v) = get("shutter")? {
+        o.shutter = v;
+    }
+    if let Some(v) = get("reshape")? {
+        o.reshape = v;
+    }
+    let count = |k: &str| m.get(k).map(|d| whole(d, k)).transpose();
+    if let Some(v) = count("blur")? {
+        o.blur_samples = v.min(1_000) as usize;
+    }
+    if let Some(v) = count("every")? {
+        o.fit_every = v.min(1_000) as usize;
+    }
+    if let Some(v) = count("stride")? {
+        o.fit.calibration_stride = v.clamp(1, 1_000_000) as usize;
+    }
+    if let Some(v) = count("rounds")? {
+        o.fit.rounds = v.clamp(1, 100) as usize;
+    }
+    let s =
+        make_golf_sequence(std::path::Path::new(c3d), &write_folder(out)?, &o).map_err(rt_err)?;
+    let mut map = Map::new();
+    let fl = |x: f64| Dynamic::from_float(x);
+    let q = &s.sequence;
+    map.insert("dir".into(), q.dir.display().to_string().into());
+    map.insert("frames".into(), Dynamic::from_int(q.frames as INT));
+    map.insert("cameras".into(), Dynamic::from_int(q.cameras as INT));
+    map.insert("width".into(), Dynamic::from_int(q.width as INT));
+    map.insert("height".into(), Dynamic::from_int(q.height as INT));
+    map.insert("seconds".into(), fl(q.seconds));
+    map.insert("seconds_per_frame".into(), fl(q.seconds_per_frame));
+    map.insert("fit_residual_rms_mm".into(), fl(s.fit_residual_rms * 1e3));
+    map.insert("lead_wrist_peak_mps".into(), fl(s.truth.lead_wrist_peak()));
+    map.insert("clubhead_peak_mps".into(), fl(s.truth.clubhead_peak()));
+    map.insert("xfactor_peak_deg".into(), fl(s.truth.x_factor_peak()));
+    let p = s.proportions;
+    let mut props = Map::new();
+    for (k, v) in [
+        ("torso", p.torso),
+        ("neck", p.neck),
+        ("head", p.head),
+        ("upper_arm", p.upper_arm),
+        ("forearm", p.forearm),
+        ("hand", p.hand),
+        ("thigh", p.thigh),
+        ("shin", p.shin),
+        ("foot", p.foot),
+        ("girth", p.girth),
+    ] {
+        props.insert(k.into(), fl(v));
+    }
+    map.insert("proportions".into(), props.into());
+    Ok(map)
+}
+
+fn golf_report_map(seq: &str, tracked: &str) -> RResult<Map> {
+    let seq = Sequence::open(read_folder(seq)?).map_err(rt_err)?;
+    let r = golf_report(&seq, &read_folder(tracked)?).map_err(rt_err)?;
+    let mut map = Map::new();
+    let fl = |x: f64| Dynamic::from_float(x);
+    map.insert("wrist_speed_err_pct".into(), fl(r.wrist_speed_err_pct()));
+    map.insert("xfactor_err_deg".into(), fl(r.xfactor_err_deg()));
+    map.insert(
+        "clubhead_speed_err_pct".into(),
+        fl(r.clubhead_speed_err_pct()),
+    );
+    map.insert(
+        "truth_lead_wrist_peak_mps".into(),
+        fl(r.truth.lead_wrist_peak()),
+    );
+    map.insert(
+        "tracked_lead_wrist_peak_mps".into(),
+        fl(r.tracked.lead_wrist_peak()),
+    );
+    map.insert("truth_xfactor_peak_deg".into(), fl(r.truth.x_factor_peak()));
+    map.insert(
+        "tracked_xfactor_peak_deg".into(),
+        fl(r.tracked.x_factor_peak()),
+    );
+    map.insert(
+        "truth_clubhead_peak_mps".into(),
+        fl(r.truth.clubhead_peak()),
+    );
+    map.insert("files".into(), Dynamic::from_int(r.files.len() as INT));
+    Ok(map)
+}
+
 /// Registers the golf swing's script functions.
 pub fn register(engine: &mut ApiBuilder) {
     function!(
@@ -86,5 +193,40 @@ residual_rms_mm, lead_wrist_peak_mps, clubhead_peak_mps, xfactor_peak_deg,
 fitted_lead_wrist_peak_mps, fitted_xfactor_peak_deg, swing_plane_deg, club_length_m,
 grip_rms_mm, peak_frame, files}.",
         |c3d: &str, out: &str, m: Map| golf(c3d, out, &m)
+    );
+    function!(
+        engine,
+        "track::golf_sequence",
+        ["c3d: String", "out: String", "options: Map", "Map"],
+        "Makes a synthetic broadcast sequence of a GEARS golf swing (C3D) into folder `out`, in
+the layout `track::make_sequence` writes (so `track_body.rhai` tracks it): the puppet fitted
+to the markers, every segment length and the girth changed by a seeded factor within
+±`reshape` (default 0.1), in clothes-like colours, holding the club fitted to its markers;
+filmed by up to 4 broadcast cameras (face-on, down the line, behind, high; 640×480, 50 fps,
+the whole swing) in front of real photos, with motion blur (`shutter` seconds, default
+1/250, `blur` instants averaged, default 5), changing light and noise. Also writes
+`club.csv` (grip and head per frame) and `truth_metrics.csv` with plots (the ground truth's
+golf metrics). Options: those of `track::make_sequence` (`cameras` ≤ 4, `width`, `height`,
+`fps`, `frames`, `start`, `noise`, `lighting`, `occluder`, `seed`, `backgrounds`,
+`makehuman`, `shading`) and `shutter`, `blur`, `reshape`, `every` (fit every n-th
+capture frame, default 2), `stride` (calibration frames, 8), `rounds` (3). A missing `c3d`
+file returns #{skipped: message}. Returns #{dir, frames, cameras, width, height, seconds,
+seconds_per_frame, fit_residual_rms_mm, lead_wrist_peak_mps, clubhead_peak_mps,
+xfactor_peak_deg, proportions}.",
+        |c3d: &str, out: &str, m: Map| golf_sequence(c3d, out, &m)
+    );
+    function!(
+        engine,
+        "track::golf_report",
+        ["seq: String", "tracked: String", "Map"],
+        "Compares the tracked joints in `tracked/tracked_joints.csv` (written by `track::body`)
+with the ground truth of the golf sequence `seq` (its `ground_truth.csv` and `club.csv`) on
+the frames tracked, and writes under `tracked`: `truth_metrics.csv`, `tracked_metrics.csv`
+(with their rotation and speed plots) and `golf_compare_speed`, `golf_compare_xfactor` (PNG,
+SVG). The club is not tracked: `clubhead_speed_err_pct` is NaN. Returns
+#{wrist_speed_err_pct, xfactor_err_deg, clubhead_speed_err_pct, truth_lead_wrist_peak_mps,
+tracked_lead_wrist_peak_mps, truth_xfactor_peak_deg, tracked_xfactor_peak_deg,
+truth_clubhead_peak_mps, files}.",
+        |seq: &str, tracked: &str| golf_report_map(seq, tracked)
     );
 }

@@ -72,6 +72,19 @@ pub(super) fn flag(d: &Dynamic, what: &str) -> RResult<bool> {
 /// Sequence options from a script map (unknown keys are errors listing the known ones).
 fn options(m: &Map) -> RResult<SequenceOptions> {
     let mut o = SequenceOptions::default();
+    apply_options(&mut o, m, "make_sequence", &[])?;
+    o.validate().map_err(rt_err)?;
+    Ok(o)
+}
+
+/// Sets the fields of `o` named in `m` (the keys of [`KEYS`]; keys in `skip` are left to the
+/// caller); an unknown key is an error naming `function` and the known keys.
+pub(super) fn apply_options(
+    o: &mut SequenceOptions,
+    m: &Map,
+    function: &str,
+    skip: &[&str],
+) -> RResult<()> {
     for (k, v) in m {
         let k = k.as_str();
         match k {
@@ -109,16 +122,20 @@ fn options(m: &Map) -> RResult<SequenceOptions> {
                     o.makehuman = read_folder(&s)?;
                 }
             }
+            other if skip.contains(&other) => {}
             other => {
                 return Err(rt_err(format!(
-                    "make_sequence: unknown option `{other}` (known: {})",
-                    KEYS.join(", ")
+                    "{function}: unknown option `{other}` (known: {})",
+                    KEYS.iter()
+                        .chain(skip)
+                        .copied()
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 )))
             }
         }
     }
-    o.validate().map_err(rt_err)?;
-    Ok(o)
+    Ok(())
 }
 
 /// The summary as a script map.

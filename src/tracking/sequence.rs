@@ -45,23 +45,19 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use image::RgbImage;
 use indicatif::ProgressBar;
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::clothing::{clothing_colours, dominant_bone, shaded_colours, skin_positions};
 use super::joints::{JointSet, TRACKING_JOINTS};
-use super::sequence_files::{
-    cover, image_path, io_err, list_photos, write_joints_csv, write_png, JointFrame, SequenceError,
-};
+use super::sequence_files::{io_err, write_joints_csv, JointFrame, SequenceError};
+use super::sequence_render::{mix, SceneMesh, SequenceWriter};
 use crate::body::bvh::{MAX_FRAME_TIME, MIN_FRAME_TIME};
 use crate::body::{Animation, BodyError, Mannequin, Motion, RetargetOptions};
 use crate::geometry::files::data_dir;
 use crate::geometry::Camera;
 use crate::geometry::{SplitMix64, Vec3};
 use crate::limits;
-use crate::render::raster::{draw_triangles, project_vertices, RasterTarget};
 
 /// Settings of [`make_sequence`]; see the [module docs](self) for what each does.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -239,131 +235,6 @@ pub fn ring_cameras(
         .collect()
 }
 
-/// The occluder of one camera: `fraction` of the image, over one side of the body's image
-/// region `bbox` (x0, y0, x1, y1) or over its legs, inside the image.
-fn place_occluder(bbox: [f64; 4], w: u32, h: u32, fraction: f64, rng: &mut SplitMix64) -> Occluder {
-    let area = fraction * w as f64 * h as f64;
-    let (bw, bh) = ((bbox[2] - bbox[0]).max(4.0), (bbox[3] - bbox[1]).max(4.0));
-    let legs = rng.uniform() < 0.4;
-    let (ow, oh, cx, cy) = if legs {
-        let ow = (1.6 * bw).clamp(area / h as f64, w as f64).round();
-        let oh = (area / ow).round().min(h as f64);
-        let cx = 0.5 * (bbox[0] + bbox[2]) + rng.range(-0.25, 0.25) * bw;
-        (ow, oh, cx, bbox[1] + 0.78 * bh + 0.5 * oh)
-    } else {
-        let oh = (0.75 * bh).clamp(area / w as f64, h as f64).round();
-        let ow = (area / oh).round().min(w as f64);
-        // the inner edge a little past the body's middle: one side hidden, the other seen
-        let (xc, half) = (0.5 * (bbox[0] + bbox[2]), (0.5 * bw).max(0.04 * w as f64));
-        let inner = 0.25 * half;
-        let cx = if rng.bit() {
-            xc - inner - 0.5 * ow
-        } else {
-            xc + inner + 0.5 * ow
-        };
-        (
-            ow,
-            oh,
-            cx,
-            0.5 * (bbox[1] + bbox[3]) + rng.range(-0.1, 0.1) * bh,
-        )
-    };
-    let (ow, oh) = (ow.max(1.0) as u32, oh.max(1.0) as u32);
-    let x0 = (cx - 0.5 * ow as f64).round().clamp(0.0, (w - ow) as f64) as u32;
-    let y0 = (cy - 0.5 * oh as f64).round().clamp(0.0, (h - oh) as f64) as u32;
-    Occluder {
-        x0,
-        y0,
-        x1: x0 + ow,
-        y1: y0 + oh,
-    }
-}
-
-/// Everything fixed about one camera, and its reusable render buffers.
-struct CameraSlot {
-    name: String,
-    camera: Camera,
-    background: RgbImage,
-    occluder: Option<(Occluder, RgbImage)>,
-    phase: f64,
-    target: RasterTarget,
-    projected: Vec<[f32; 3]>,
-    image: RgbImage,
-    noise_seed: u64,
-}
-
-/// A seed for stream `a`, `b` of `seed`.
-fn mix(seed: u64, a: u64, b: u64) -> u64 {
-    let mut r = SplitMix64::new(
-        seed ^ a.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ b.wrapping_mul(0xD1B5_4A32_D192_ED03),
-    );
-    r.next_u64()
-}
-
-/// Renders one camera's image of the current frame into `slot.image`.
-#[allow(clippy::too_many_arguments)]
-fn render(
-    slot: &mut CameraSlot,
-    skin: &[Vec3],
-    colours: &[[f32; 3]],
-    triangles: &[[u32; 3]],
-    noise: &[f32],
-    t: f64,
-    frame: usize,
-    o: &SequenceOptions,
-) {
-    slot.target.clear();
-    if o.body {
-        project_vertices(&slot.camera, skin, &mut slot.projected);
-        draw_triangles(&mut slot.target, &slot.projected, colours, triangles);
-    }
-    let (w, h) = (slot.camera.width, slot.camera.height);
-    let a = o.lighting_amplitude;
-    let tau = std::f64::consts::TAU;
-    let gain = 1.0 + a * (tau * t / 2.0).sin();
-    let slope = 0.5 * a * (tau * t / 7.0 + slot.phase).sin();
-    let mut rng = SplitMix64::new(mix(slot.noise_seed, frame as u64, 7));
-    let sigma = o.noise_sigma as f32;
-    for y in 0..h {
-        for x in 0..w {
-            let i = (y * w + x) as usize;
-            let base = match &slot.occluder {
-                Some((r, tex)) if r.contains(x, y) => {
-                    tex.get_pixel(x - r.x0, y - r.y0).0.map(f32::from)
-                }
-                _ if slot.target.depth[i].is_finite() => slot.target.rgb[i],
-                _ => slot.background.get_pixel(x, y).0.map(f32::from),
-            };
-            let g = (gain * (1.0 + slope * (2.0 * (x as f64 + 0.5) / w as f64 - 1.0))) as f32;
-            // three 16-bit draws from the normal table, one per channel
-            let bits = if sigma > 0.0 { rng.next_u64() } else { 0 };
-            let mut px = [0u8; 3];
-            for (c, out) in px.iter_mut().enumerate() {
-                let n = if sigma > 0.0 {
-                    sigma * noise[(bits >> (16 * c)) as usize & 0xFFFF]
-                } else {
-                    0.0
-                };
-                *out = (base[c] * g + n).round().clamp(0.0, 255.0) as u8;
-            }
-            slot.image.put_pixel(x, y, image::Rgb(px));
-        }
-    }
-}
-
-/// 65 536 standard normal samples (Box–Muller from `seed`), shifted and scaled to mean 0 and
-/// variance 1 exactly: the sensor noise draws from this table with 16 random bits, which is
-/// several times faster than drawing normals per pixel.
-fn normal_table(seed: u64) -> Vec<f32> {
-    let mut rng = SplitMix64::new(seed);
-    let mut v: Vec<f64> = (0..1 << 16).map(|_| rng.normal()).collect();
-    let n = v.len() as f64;
-    let mean = v.iter().sum::<f64>() / n;
-    let sd = (v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / n).sqrt();
-    v.iter_mut().for_each(|x| *x = (*x - mean) / sd);
-    v.into_iter().map(|x| x as f32).collect()
-}
-
 /// Makes a synthetic sequence of `motion` (a BVH clip) into folder `out` (created; existing
 /// files are overwritten): see the [module docs](self) for the layout and what is rendered.
 pub fn make_sequence(
@@ -429,98 +300,9 @@ pub fn make_sequence(
     let cameras = ring_cameras(o.cameras, w, h, centre)?;
 
     // backgrounds and occluders, one seeded stream per camera
-    let photos = list_photos(&o.backgrounds)?;
-    let mut order: Vec<usize> = (0..photos.len()).collect();
-    let mut rng = SplitMix64::new(mix(o.seed, 1, 0));
-    for i in (1..order.len()).rev() {
-        order.swap(i, rng.below(i + 1));
-    }
-    let mut slots = Vec::with_capacity(cameras.len());
-    let mut meta_cams = Vec::new();
-    for (c, camera) in cameras.into_iter().enumerate() {
-        let mut rng = SplitMix64::new(mix(o.seed, 2, c as u64));
-        let bg_index = order[c % order.len()];
-        let background = cover(&photos[bg_index], w, h, &mut rng)?;
-        let mut bbox = [
-            f64::INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::NEG_INFINITY,
-        ];
-        for p in truth.iter().flatten() {
-            if let Some(uv) = camera.project(p) {
-                bbox = [
-                    bbox[0].min(uv[0]),
-                    bbox[1].min(uv[1]),
-                    bbox[2].max(uv[0]),
-                    bbox[3].max(uv[1]),
-                ];
-            }
-        }
-        if !bbox[0].is_finite() {
-            bbox = [
-                0.25 * w as f64,
-                0.1 * h as f64,
-                0.75 * w as f64,
-                0.9 * h as f64,
-            ];
-        }
-        let occluder = if o.occluder_fraction > 0.0 {
-            let rect = place_occluder(bbox, w, h, o.occluder_fraction, &mut rng);
-            let mut tex_index = order[(c + o.cameras) % order.len()];
-            if tex_index == bg_index && photos.len() > 1 {
-                tex_index = order[(c + o.cameras + 1) % order.len()];
-            }
-            let tex = cover(
-                &photos[tex_index],
-                rect.x1 - rect.x0,
-                rect.y1 - rect.y0,
-                &mut rng,
-            )?;
-            Some((rect, tex, tex_index))
-        } else {
-            None
-        };
-        let name = format!("cam{c}");
-        let file_name = |i: usize| {
-            photos[i]
-                .file_name()
-                .map(|n| n.to_string_lossy().into_owned())
-        };
-        meta_cams.push(serde_json::json!({
-            "name": name,
-            "background": file_name(bg_index),
-            "occluder": occluder.as_ref().map(|(r, _, _)| r),
-            "occluder_texture": occluder.as_ref().map(|o| file_name(o.2)),
-        }));
-        slots.push(CameraSlot {
-            name,
-            target: RasterTarget::new(w as usize, h as usize),
-            projected: Vec::new(),
-            image: RgbImage::new(w, h),
-            background,
-            occluder: occluder.map(|(r, t, _)| (r, t)),
-            phase: std::f64::consts::TAU * c as f64 / o.cameras as f64,
-            noise_seed: mix(o.seed, 3, c as u64),
-            camera,
-        });
-    }
-
-    // files that do not depend on the frames
-    for dir in [
-        out.to_path_buf(),
-        out.join("cameras"),
-        out.join("backgrounds"),
-    ]
-    .into_iter()
-    .chain(slots.iter().map(|s| out.join("images").join(&s.name)))
-    {
-        std::fs::create_dir_all(&dir).map_err(io_err(&dir))?;
-    }
-    for s in &slots {
-        s.camera
-            .save(out.join("cameras").join(format!("{}.json", s.name)))?;
-    }
+    let points: Vec<Vec3> = truth.iter().flatten().copied().collect();
+    let mut writer = SequenceWriter::new(out, cameras, &points, o)?;
+    writer.write_cameras_and_plates()?;
     let motion_name = motion.file_name().map(|n| n.to_string_lossy().into_owned());
     let meta = serde_json::json!({
         "format": "emilion sequence",
@@ -529,7 +311,7 @@ pub fn make_sequence(
         "frames": frames,
         "width": w,
         "height": h,
-        "cameras": slots.iter().map(|s| s.name.clone()).collect::<Vec<_>>(),
+        "cameras": writer.camera_names(),
         "motion": motion_name,
         "start_time": o.start_time,
         "joints": TRACKING_JOINTS.map(|j| j.name),
@@ -540,7 +322,7 @@ pub fn make_sequence(
         "lbs": o.lbs,
         "body": o.body,
         "seed": o.seed,
-        "camera_details": meta_cams,
+        "camera_details": writer.camera_details,
     });
     let meta_path = out.join("sequence.json");
     let text = serde_json::to_string_pretty(&meta).map_err(|e| SequenceError::Json {
@@ -558,43 +340,36 @@ pub fn make_sequence(
     let init = truth[0].map(|p| p + Vec3::new(rng.normal(), rng.normal(), rng.normal()) * 0.02);
     write_joints_csv(&out.join("init_joints.csv"), &[(0, 0.0, init)])?;
 
-    // the clean plates: the scene without the body, with noise of its own
-    let noise = normal_table(mix(o.seed, 5, 0));
-    let empty = SequenceOptions {
-        body: false,
-        ..o.clone()
-    };
-    slots.par_iter_mut().try_for_each(|s| {
-        render(s, &[], &[], &[], &noise, 0.0, usize::MAX, &empty);
-        write_png(
-            &out.join("backgrounds").join(format!("{}.png", s.name)),
-            &s.image,
-        )
-    })?;
-
     // the frames: cameras rendered in parallel
     let pb = if std::io::stderr().is_terminal() {
         ProgressBar::new(frames as u64)
     } else {
         ProgressBar::hidden()
     };
-    let (mut skin, mut normals, mut colours) = (Vec::new(), Vec::new(), Vec::new());
+    let mut scene = [SceneMesh {
+        triangles,
+        ..SceneMesh::default()
+    }];
+    let mut normals = Vec::new();
     for k in 0..frames {
         let t = time(k);
         anim.pose_at_into(t, &mut pose);
-        skin_positions(anim.mannequin(), &pose, dominant.as_deref(), &mut skin);
+        let s = &mut scene[0];
+        skin_positions(
+            anim.mannequin(),
+            &pose,
+            dominant.as_deref(),
+            &mut s.positions,
+        );
         shaded_colours(
-            &skin,
-            &triangles,
+            &s.positions,
+            &s.triangles,
             &base_colours,
             &mut normals,
-            &mut colours,
+            &mut s.colours,
             o.shading,
         );
-        slots.par_iter_mut().try_for_each(|s| {
-            render(s, &skin, &colours, &triangles, &noise, t, k, o);
-            write_png(&image_path(out, &s.name, k), &s.image)
-        })?;
+        writer.write_frame(k, t, &scene)?;
         pb.inc(1);
     }
     pb.finish_and_clear();

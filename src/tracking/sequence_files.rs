@@ -126,6 +126,14 @@ pub enum SequenceError {
     /// The motion clip or the mannequin could not be loaded or retargeted.
     #[error(transparent)]
     Body(#[from] BodyError),
+    /// The motion source (a capture file) could not be fitted or used.
+    #[error("{path}: {message}")]
+    Motion {
+        /// The motion file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
     /// Invalid sequence options.
     #[error("invalid sequence options: {0}")]
     Options(String),

@@ -1,0 +1,537 @@
+//! Synthetic broadcast sequences of a real golf swing, with ground truth
+//! ([`make_golf_sequence`]): the GEARS C3D swing is fitted with the puppet
+//! ([`super::marker_fit`]) and its club ([`super::club`]); the golfer is that fitted body
+//! with every segment length and the girth changed by a seeded factor within
+//! ±[`GolfSequenceOptions::reshape`] (so the tracker's puppet, built on the plain mannequin,
+//! is not the observed person), in clothes-like colours ([`super::clothing`]), holding the
+//! club; filmed by broadcast cameras ([`broadcast_cameras`]: face-on, down the line, from
+//! behind, high) at 640×480 and 50 fps, with motion blur from the shutter time (each frame is
+//! the mean of [`GolfSequenceOptions::blur_samples`] instants over the shutter's opening), in
+//! front of real photos, with changing light and noise ([`super::sequence_render`]).
+//!
+//! The swing's parameters are fitted on every [`GolfSequenceOptions::fit_every`]-th capture
+//! frame and interpolated linearly in time between them; the club is carried in the lead
+//! hand's bone frame (its grip held at one place in the hand, the shaft turned as captured,
+//! moved to the reshaped hand), so the reshaped golfer holds it.
+//!
+//! # Output layout
+//!
+//! The layout of [`super::sequence`] (read by [`super::sequence_files::Sequence::open`], so
+//! the body tracker reads it as any sequence), with `sequence.json` also holding a `golf`
+//! object (capture file, proportions, shutter, camera roles), and besides:
+//!
+//! ```text
+//! DIR/club.csv               frame,time,grip_x,grip_y,grip_z,head_x,head_y,head_z (metres)
+//! DIR/truth_metrics.csv      the golf metrics of the ground truth (joints and club at the
+//!                            frames' times), with its _rotation and _speed plots
+//! ```
+
+use std::path::Path;
+use std::time::Instant;
+
+use super::clothing::{clothing_colours, shaded_colours};
+use super::club::{fit_club, ClubFit, GEARS_CLUB};
+use super::club_mesh::ClubMesh;
+use super::golf_metrics::{golf_metrics, write_golf_metrics, GolfMetrics};
+use super::joints::{JOINT_COUNT, TRACKING_JOINTS};
+use super::marker_fit::{fit_markers, MarkerFitOptions};
+use super::marker_set::MarkerSet;
+use super::puppet::{Proportions, Puppet};
+use super::sequence::{SequenceOptions, SequenceSummary};
+use super::sequence_files::{io_err, write_joints_csv, SequenceError};
+use super::sequence_render::{mix, SceneMesh, SequenceWriter};
+use crate::body::{read_c3d, Mannequin, Pose};
+use crate::geometry::Camera;
+use crate::geometry::{SplitMix64, Vec3};
+use crate::limits;
+
+/// Tracking joints of the hips (`l_hip`, `r_hip` of [`TRACKING_JOINTS`]).
+const JOINT_L_HIP: usize = 10;
+const JOINT_R_HIP: usize = 13;
+
+/// The broadcast cameras' roles, in camera order.
+pub const CAMERA_ROLES: [&str; 4] = ["face-on", "down-the-line", "behind", "high"];
+
+/// Settings of [`make_golf_sequence`].
+#[derive(Clone, Debug)]
+pub struct GolfSequenceOptions {
+    /// Image size, frame rate, frames, noise, light, occluder, photos, seed (its `cameras`,
+    /// 1..=4, takes the first of [`CAMERA_ROLES`]). Defaults: 4 cameras, 640×480, 50 fps, the
+    /// whole swing, noise 3, light 0.1, no occluder.
+    pub sequence: SequenceOptions,
+    /// Shutter time, seconds (0 ..= one frame). Default 1/250 s.
+    pub shutter: f64,
+    /// Instants averaged over the shutter (1..=32; 1 = no blur). Default 5.
+    pub blur_samples: usize,
+    /// Largest relative change of each segment length and of the girth (0..=0.2). Default 0.1.
+    pub reshape: f64,
+    /// Fit every this many capture frames (1..=60). Default 2.
+    pub fit_every: usize,
+    /// The marker fit's settings. Default: stride 8, 3 rounds.
+    pub fit: MarkerFitOptions,
+}
+
+impl Default for GolfSequenceOptions {
+    fn default() -> Self {
+        GolfSequenceOptions {
+            sequence: SequenceOptions {
+                width: 640,
+                height: 480,
+                noise_sigma: 3.0,
+                lighting_amplitude: 0.1,
+                occluder_fraction: 0.0,
+                ..SequenceOptions::default()
+            },
+            shutter: 1.0 / 250.0,
+            blur_samples: 5,
+            reshape: 0.1,
+            fit_every: 2,
+            fit: MarkerFitOptions {
+                rounds: 3,
+                ..MarkerFitOptions::default()
+            },
+        }
+    }
+}
+
+impl GolfSequenceOptions {
+    /// Checks the ranges given in the field docs.
+    pub fn validate(&self) -> Result<(), SequenceError> {
+        self.sequence.validate()?;
+        let bad = |m: String| Err(SequenceError::Options(m));
+        if self.sequence.cameras > CAMERA_ROLES.len() {
+            return bad(format!(
+                "cameras must be in 1..=4 for a golf sequence ({}), got {}",
+                CAMERA_ROLES.join(", "),
+                self.sequence.cameras
+            ));
+        }
+        let frame = 1.0 / self.sequence.fps;
+        if !(self.shutter.is_finite() && (0.0..=frame).contains(&self.shutter)) {
+            return bad(format!(
+                "shutter must be in [0, {frame}] s (one frame), got {}",
+                self.shutter
+            ));
+        }
+        if !(1..=32).contains(&self.blur_samples) {
+            return bad(format!(
+                "blur_samples must be in 1..=32, got {}",
+                self.blur_samples
+            ));
+        }
+        if !(self.reshape.is_finite() && (0.0..=0.2).contains(&self.reshape)) {
+            return bad(format!("reshape must be in [0, 0.2], got {}", self.reshape));
+        }
+        if !(1..=60).contains(&self.fit_every) {
+            return bad(format!(
+                "fit_every must be in 1..=60, got {}",
+                self.fit_every
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// What [`make_golf_sequence`] wrote and measured.
+#[derive(Clone, Debug)]
+pub struct GolfSequenceSummary {
+    /// Folder, frames, cameras, size, wall time.
+    pub sequence: SequenceSummary,
+    /// The golfer's proportions (relative to the mannequin).
+    pub proportions: Proportions,
+    /// The marker fit's residual RMS, metres.
+    pub fit_residual_rms: f64,
+    /// The ground truth's golf metrics.
+    pub truth: GolfMetrics,
+}
+
+/// `p` with each field multiplied by a factor drawn uniformly in `[1 − r, 1 + r]` from `rng`.
+fn reshaped(p: Proportions, r: f64, rng: &mut SplitMix64) -> Proportions {
+    let mut f = || 1.0 + rng.range(-r, r);
+    Proportions {
+        torso: p.torso * f(),
+        neck: p.neck * f(),
+        head: p.head * f(),
+        upper_arm: p.upper_arm * f(),
+        forearm: p.forearm * f(),
+        hand: p.hand * f(),
+        thigh: p.thigh * f(),
+        shin: p.shin * f(),
+        foot: p.foot * f(),
+        girth: p.girth * f(),
+    }
+}
+
+/// The swing as a function of time: the fitted parameters and the club in the lead hand's
+/// rest frame, sampled at `rate`, interpolated linearly.
+struct Swing {
+    rate: f64,
+    params: Vec<Vec<f64>>,
+    /// Grip and head in the golfer's lead-hand rest frame, per fitted frame.
+    club: Vec<(Vec3, Vec3)>,
+    hand: usize,
+}
+
+impl Swing {
+    /// Parameters, grip and head (golfer's rest frame of the hand) at time `t`.
+    fn at(&self, t: f64, params: &mut Vec<f64>) -> (Vec3, Vec3) {
+        let n = self.params.len();
+        let x = (t * self.rate).clamp(0.0, (n - 1) as f64);
+        let i = (x.floor() as usize).min(n - 1);
+        let j = (i + 1).min(n - 1);
+        let w = x - i as f64;
+        params.clear();
+        params.extend(
+            self.params[i]
+                .iter()
+                .zip(&self.params[j])
+                .map(|(a, b)| a + (b - a) * w),
+        );
+        let (a, b) = (self.club[i], self.club[j]);
+        (a.0 + (b.0 - a.0) * w, a.1 + (b.1 - a.1) * w)
+    }
+}
+
+/// Club points per fitted frame in the fitted hand's rest frame, moved to the golfer's hand
+/// (`shift`); frames without a club fit take the nearest frame's. The grip is then held at
+/// its mean place in the hand (the capture's wrist marker slides on the club by a few
+/// centimetres, which would show the club beside the hands), the shaft keeping each frame's
+/// direction and length. Fails when no frame has a club fit.
+fn club_in_hand(
+    fit_puppet: &Puppet,
+    params: &[Vec<f64>],
+    club: &ClubFit,
+    hand: usize,
+    shift: Vec3,
+) -> Result<Vec<(Vec3, Vec3)>, String> {
+    let mut pose = Pose::identity(fit_puppet.bone_count());
+    let local: Vec<Option<(Vec3, Vec3)>> = params
+        .iter()
+        .enumerate()
+        .map(|(f, p)| {
+            let (g, h) = (club.grip.get(f).copied()??, club.head.get(f).copied()??);
+            fit_puppet.pose_into(p, &mut pose);
+            let inv = pose.transform(hand).inverse();
+            let to_rest = |x: Vec3| (inv * nalgebra::Point3::from(x)).coords + shift;
+            Some((to_rest(g), to_rest(h)))
+        })
+        .collect();
+    let seen: Vec<usize> = (0..local.len()).filter(|&f| local[f].is_some()).collect();
+    if seen.is_empty() {
+        return Err("no frame sees three club markers".into());
+    }
+    let filled: Vec<(Vec3, Vec3)> = (0..local.len())
+        .map(|f| {
+            let k = seen.partition_point(|&s| s < f);
+            let near = match (k.checked_sub(1).map(|i| seen[i]), seen.get(k)) {
+                (Some(a), Some(&b)) => {
+                    if f - a <= b - f {
+                        a
+                    } else {
+                        b
+                    }
+                }
+                (Some(a), None) => a,
+                (None, Some(&b)) => b,
+                (None, None) => unreachable!("seen is not empty"),
+            };
+            local[f].unwrap_or_else(|| local[near].expect("a seen frame"))
+        })
+        .collect();
+    // the grip held fixed in the hand (its mean place), the shaft turned as captured
+    let grip = filled.iter().map(|x| x.0).sum::<Vec3>() / filled.len() as f64;
+    Ok(filled
+        .into_iter()
+        .map(|(g, h)| (grip, grip + (h - g)))
+        .collect())
+}
+
+/// The broadcast cameras around a golfer whose pelvis stands at `pelvis`, facing `forward`
+/// (horizontal unit vector, toward the ball) with the target along `target` (horizontal unit
+/// vector): face-on, down the line (behind the trail side, looking at the target), from
+/// behind, and high (a crane in front toward the target). Each camera's focal length makes
+/// `points` (the body's joints over the swing) fill 80 % of the image's width or height, as a
+/// broadcaster frames the player: the club head leaves the picture at the top of the swing.
+pub fn broadcast_cameras(
+    n: usize,
+    width: u32,
+    height: u32,
+    pelvis: Vec3,
+    forward: Vec3,
+    target: Vec3,
+    points: &[Vec3],
+) -> Result<Vec<Camera>, SequenceError> {
+    let centre = Vec3::new(pelvis.x, pelvis.y, 1.0);
+    let places = [
+        (forward, 6.0, 1.2),
+        ((-target + forward * 0.15).normalize(), 7.0, 1.5),
+        ((-forward + target * 0.4).normalize(), 6.5, 1.6),
+        ((forward + target).normalize(), 7.5, 4.5),
+    ];
+    places
+        .iter()
+        .take(n)
+        .enumerate()
+        .map(|(k, &(dir, dist, h))| {
+            let eye = Vec3::new(centre.x, centre.y, 0.0) + dir * dist + Vec3::z() * h;
+            let probe = Camera::looking_at_up(eye, centre, Vec3::z(), 1.0, width, height);
+            let (mut sx, mut sy) = (1e-6f64, 1e-6f64);
+            for p in points {
+                let c = probe.to_camera_frame(p);
+                if c.z > 0.1 {
+                    sx = sx.max((c.x / c.z).abs());
+                    sy = sy.max((c.y / c.z).abs());
+                }
+            }
+            let focal = (0.4 * width as f64 / sx).min(0.4 * height as f64 / sy);
+            let cam = Camera {
+                k1: -0.02,
+                ..Camera::looking_at_up(eye, centre, Vec3::z(), focal, width, height)
+            };
+            cam.validate_named(&format!("cam{k} ({})", CAMERA_ROLES[k]))?;
+            Ok(cam)
+        })
+        .collect()
+}
+
+/// Makes a broadcast sequence of the golf swing in `c3d` (a GEARS capture) into `out`
+/// (created; existing files are overwritten): see the [module docs](self).
+pub fn make_golf_sequence(
+    c3d: &Path,
+    out: &Path,
+    options: &GolfSequenceOptions,
+) -> Result<GolfSequenceSummary, SequenceError> {
+    let start = Instant::now();
+    options.validate()?;
+    let o = &options.sequence;
+    let motion_err = |m: String| SequenceError::Motion {
+        path: c3d.to_path_buf(),
+        message: m,
+    };
+    let mannequin = Mannequin::load_makehuman(&o.makehuman)?;
+    let mut trial = read_c3d(c3d)?;
+    trial.up = trial.infer_up();
+    let sub = trial.every(options.fit_every);
+    let fit = fit_markers(&mannequin, &sub, &MarkerSet::gears(), &options.fit)
+        .map_err(|m| motion_err(format!("marker fit: {m}")))?;
+    let (a, b, wrist) = GEARS_CLUB;
+    let club = fit_club(&sub, &a, &b, wrist).map_err(motion_err)?;
+    let mut rng = SplitMix64::new(mix(o.seed, 6, 0));
+    let proportions = reshaped(fit.puppet.proportions(), options.reshape, &mut rng);
+    let golfer = fit
+        .puppet
+        .with_proportions(&proportions)
+        .map_err(motion_err)?;
+    let hand = mannequin
+        .skeleton()
+        .bone_index("wrist.L")
+        .ok_or_else(|| motion_err("the mannequin has no bone wrist.L".into()))?;
+    let shift = golfer.rest_heads()[hand] - fit.puppet.rest_heads()[hand];
+    let swing = Swing {
+        rate: sub.rate,
+        club: club_in_hand(&fit.puppet, &fit.params, &club, hand, shift).map_err(motion_err)?,
+        params: fit.params.clone(),
+        hand,
+    };
+    let colours = clothing_colours(&mannequin, o.seed);
+    if colours.len() != golfer.rest_skin().len() {
+        return Err(motion_err(
+            "the puppet's skin is not the mannequin's".into(),
+        ));
+    }
+
+    let frames = match o.frames {
+        Some(f) => f,
+        None => {
+            let n = ((trial.duration() - o.start_time).max(0.0) * o.fps + 1e-9).floor() + 1.0;
+            let what = format!("the frame count of {}", c3d.display());
+            limits::check(&what, n, "max_frames", limits::get().max_frames)
+                .map_err(|e| SequenceError::Options(e.to_string()))? as usize
+        }
+    };
+    let time = |k: usize| k as f64 / o.fps;
+
+    // the golfer at instant t: skin, joints, grip and head in the world
+    let mut pose = Pose::identity(golfer.bone_count());
+    let mut params = Vec::new();
+    let mut club_mesh = ClubMesh::new();
+    let mut at = |t: f64, skin: Option<&mut Vec<Vec3>>| {
+        let (g, h) = swing.at(o.start_time + t, &mut params);
+        golfer.pose_into(&params, &mut pose);
+        if let Some(skin) = skin {
+            golfer.skin(&pose, skin);
+        }
+        let joints = golfer.joints(&pose);
+        (joints, pose.apply(swing.hand, g), pose.apply(swing.hand, h))
+    };
+    let truth: Vec<([Vec3; JOINT_COUNT], Vec3, Vec3)> =
+        (0..frames).map(|k| at(time(k), None)).collect();
+
+    // cameras from the address position, framing the whole swing
+    let first = truth[0].0;
+    let (l_hip, r_hip) = (JOINT_L_HIP, JOINT_R_HIP);
+    let flat = |v: Vec3| Vec3::new(v.x, v.y, 0.0);
+    let target = flat(first[l_hip] - first[r_hip])
+        .try_normalize(1e-9)
+        .unwrap_or_else(Vec3::x);
+    let forward = target.cross(&Vec3::z());
+    let points: Vec<Vec3> = truth
+        .iter()
+        .flat_map(|(j, _, _)| j.iter().copied())
+        .collect();
+    let cameras = broadcast_cameras(
+        o.cameras, o.width, o.height, first[0], forward, target, &points,
+    )?;
+    let mut writer = SequenceWriter::new(out, cameras, &points, o)?;
+    writer.write_cameras_and_plates()?;
+    write_ground_truth(out, &truth, &time, o.seed)?;
+    let truth_club = ClubFit {
+        rate: o.fps,
+        head_markers: Vec::new(),
+        shaft_markers: Vec::new(),
+        head: truth.iter().map(|x| Some(x.2)).collect(),
+        grip: truth.iter().map(|x| Some(x.1)).collect(),
+        length: club.length,
+        grip_rms: club.grip_rms,
+    };
+    let joints: Vec<[Vec3; JOINT_COUNT]> = truth.iter().map(|x| x.0).collect();
+    let metrics = golf_metrics(&joints, o.fps, Some(&truth_club));
+    write_golf_metrics(out, "truth_metrics", &metrics)
+        .map_err(|e| SequenceError::Options(e.to_string()))?;
+    let meta = serde_json::json!({
+        "format": "emilion sequence",
+        "version": 1,
+        "fps": o.fps,
+        "frames": frames,
+        "width": o.width,
+        "height": o.height,
+        "cameras": writer.camera_names(),
+        "motion": c3d.file_name().map(|n| n.to_string_lossy().into_owned()),
+        "start_time": o.start_time,
+        "joints": TRACKING_JOINTS.map(|j| j.name),
+        "noise_sigma": o.noise_sigma,
+        "lighting_amplitude": o.lighting_amplitude,
+        "occluder_fraction": o.occluder_fraction,
+        "seed": o.seed,
+        "camera_details": writer.camera_details,
+        "golf": {
+            "roles": &CAMERA_ROLES[..o.cameras],
+            "shutter": options.shutter,
+            "blur_samples": options.blur_samples,
+            "reshape": options.reshape,
+            "fit_every": options.fit_every,
+            "fit_residual_rms_mm": fit.rms() * 1e3,
+            "club_length": club.length,
+            "proportions": proportions_json(&proportions),
+        },
+    });
+    let meta_path = out.join("sequence.json");
+    let text = serde_json::to_string_pretty(&meta).map_err(|e| SequenceError::Json {
+        path: meta_path.clone(),
+        message: e.to_string(),
+    })?;
+    std::fs::write(&meta_path, text + "\n").map_err(io_err(&meta_path))?;
+
+    // the frames: the shutter's instants, each the body and the club, shaded
+    let body_triangles: Vec<[u32; 3]> = mannequin
+        .triangles()
+        .iter()
+        .map(|t| t.map(|i| i as u32))
+        .collect();
+    let offset = colours.len() as u32;
+    let triangles: Vec<[u32; 3]> = body_triangles
+        .iter()
+        .copied()
+        .chain(club_mesh.triangles.iter().map(|t| t.map(|i| i + offset)))
+        .collect();
+    let base: Vec<[f32; 3]> = colours.iter().chain(&club_mesh.colours).copied().collect();
+    let blur = options.blur_samples;
+    let mut shutter: Vec<SceneMesh> = vec![SceneMesh::default(); blur];
+    let mut normals = Vec::new();
+    let mut skin = Vec::new();
+    for k in 0..frames {
+        for (j, scene) in shutter.iter_mut().enumerate() {
+            let phase = if blur > 1 {
+                j as f64 / (blur - 1) as f64 - 0.5
+            } else {
+                0.0
+            };
+            let (_, g, h) = at(time(k) + phase * options.shutter, Some(&mut skin));
+            club_mesh.place(g, h);
+            scene.positions.clear();
+            scene.positions.extend_from_slice(&skin);
+            scene.positions.extend_from_slice(&club_mesh.positions);
+            if scene.triangles.is_empty() {
+                scene.triangles.clone_from(&triangles);
+            }
+            shaded_colours(
+                &scene.positions,
+                &triangles,
+                &base,
+                &mut normals,
+                &mut scene.colours,
+                o.shading,
+            );
+        }
+        writer.write_frame(k, time(k), &shutter)?;
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    Ok(GolfSequenceSummary {
+        sequence: SequenceSummary {
+            dir: out.to_path_buf(),
+            frames,
+            cameras: o.cameras,
+            width: o.width,
+            height: o.height,
+            seconds,
+            seconds_per_frame: seconds / frames as f64,
+        },
+        proportions,
+        fit_residual_rms: fit.rms(),
+        truth: metrics,
+    })
+}
+
+/// `ground_truth.csv`, `init_joints.csv` (frame 0 with 2 cm of seeded noise, as
+/// [`super::sequence`] writes it) and `club.csv`.
+fn write_ground_truth(
+    out: &Path,
+    truth: &[([Vec3; JOINT_COUNT], Vec3, Vec3)],
+    time: &dyn Fn(usize) -> f64,
+    seed: u64,
+) -> Result<(), SequenceError> {
+    let rows: Vec<_> = truth
+        .iter()
+        .enumerate()
+        .map(|(k, x)| (k, time(k), x.0))
+        .collect();
+    write_joints_csv(&out.join("ground_truth.csv"), &rows)?;
+    let mut rng = SplitMix64::new(mix(seed, 4, 0));
+    let init = truth[0]
+        .0
+        .map(|p| p + Vec3::new(rng.normal(), rng.normal(), rng.normal()) * 0.02);
+    write_joints_csv(&out.join("init_joints.csv"), &[(0, 0.0, init)])?;
+    let mut csv = String::from("frame,time,grip_x,grip_y,grip_z,head_x,head_y,head_z\n");
+    for (k, (_, g, h)) in truth.iter().enumerate() {
+        csv += &format!(
+            "{k},{},{},{},{},{},{},{}\n",
+            time(k),
+            g.x,
+            g.y,
+            g.z,
+            h.x,
+            h.y,
+            h.z
+        );
+    }
+    let path = out.join("club.csv");
+    std::fs::write(&path, csv).map_err(io_err(&path))
+}
+
+fn proportions_json(p: &Proportions) -> serde_json::Value {
+    serde_json::json!({
+        "torso": p.torso, "neck": p.neck, "head": p.head, "upper_arm": p.upper_arm,
+        "forearm": p.forearm, "hand": p.hand, "thigh": p.thigh, "shin": p.shin,
+        "foot": p.foot, "girth": p.girth,
+    })
+}
