@@ -122,20 +122,8 @@ fn golf_sequence(c3d: &str, out: &str, m: &Map) -> RResult<Map> {
     map.insert("lead_wrist_peak_mps".into(), fl(s.truth.lead_wrist_peak()));
     map.insert("clubhead_peak_mps".into(), fl(s.truth.clubhead_peak()));
     map.insert("xfactor_peak_deg".into(), fl(s.truth.x_factor_peak()));
-    let p = s.proportions;
     let mut props = Map::new();
-    for (k, v) in [
-        ("torso", p.torso),
-        ("neck", p.neck),
-        ("head", p.head),
-        ("upper_arm", p.upper_arm),
-        ("forearm", p.forearm),
-        ("hand", p.hand),
-        ("thigh", p.thigh),
-        ("shin", p.shin),
-        ("foot", p.foot),
-        ("girth", p.girth),
-    ] {
+    for (k, v) in s.proportions.named() {
         props.insert(k.into(), fl(v));
     }
     map.insert("proportions".into(), props.into());

@@ -8,6 +8,7 @@ use rhai::{Dynamic, Map, INT};
 use super::checkpoint::{begin, resumed_file, Plan};
 use super::convert::{count, finite, rt_err, RResult};
 use super::paths::{read_folder, read_folder_opt, write_folder};
+use super::tracking_sequence::flag;
 use super::{function, modules::ApiBuilder};
 use crate::body::Mannequin;
 use crate::geometry::checkpoint::Fingerprint;
@@ -77,6 +78,7 @@ fn options(m: &Map) -> RResult<(TrackerOptions, TrackOutputOptions, Option<Strin
                     .map_err(|_| rt_err("`recover` must be true or false"))?
             }
             "first_frame" => o.first_frame = count(v, "first_frame")?,
+            "adapt_body" => o.adapt_body = flag(v, "adapt_body")?,
             "frames" => o.frames = Some(count(v, "frames")?),
             "overlay_every" => out.overlay_every = count(v, "overlay_every")?,
             "makehuman" => makehuman = Some(v.to_string()),

@@ -6,6 +6,7 @@
 
 use super::joints::JOINT_COUNT;
 use super::loss::FrameStatus;
+use super::puppet::Proportions;
 use super::tracker::{TrackResult, Tracker};
 use crate::geometry::checkpoint::{Decoder, Encoder};
 use crate::geometry::{GeometryError, SplitMix64, Vec3};
@@ -42,6 +43,9 @@ impl TrackCheckpoint {
     pub fn restore(&self, tracker: &mut Tracker) -> Result<(), String> {
         if self.stage_seconds.len() != tracker.stage_seconds.len() {
             return Err("the checkpoint's tracker has other stages".into());
+        }
+        if let Some(p) = &self.result.proportions {
+            tracker.set_proportions(p).map_err(|e| e.to_string())?;
         }
         let params = tracker.puppet().params().len();
         if self.history.iter().any(|h| h.len() != params) {
@@ -85,6 +89,10 @@ impl TrackCheckpoint {
         }
         e.f64s(&self.stage_seconds);
         e.usize(self.evaluations);
+        e.bool(r.proportions.is_some());
+        if let Some(p) = &r.proportions {
+            e.f64s(&p.named().map(|x| x.1));
+        }
         e.buf
     }
 
@@ -134,6 +142,13 @@ impl TrackCheckpoint {
         };
         let stage_seconds = d.f64s("stage times")?;
         let evaluations = d.usize("evaluations")?;
+        if d.bool("proportions")? {
+            let v = d.f64s("proportions")?;
+            result.proportions = Some(
+                Proportions::from_values(&v)
+                    .ok_or_else(|| d.error("proportions: 10 values expected"))?,
+            );
+        }
         if !d.finished() {
             return Err(d.error("bytes left over after the tracker's state"));
         }

@@ -250,8 +250,9 @@ fn club_in_hand(
 /// (horizontal unit vector, toward the ball) with the target along `target` (horizontal unit
 /// vector): face-on, down the line (behind the trail side, looking at the target), from
 /// behind, and high (a crane in front toward the target). Each camera's focal length makes
-/// `points` (the body's joints over the swing) fill 80 % of the image's width or height, as a
-/// broadcaster frames the player: the club head leaves the picture at the top of the swing.
+/// `points` (the body and the club over the swing) fill 85 % of the image's width or height:
+/// the whole swing stays in the picture. (Framing the body alone, 80 %, made the golfer twice
+/// as tall in the image and the tracking 3.4 times slower and no better: 90 mm against 83.)
 pub fn broadcast_cameras(
     n: usize,
     width: u32,
@@ -283,7 +284,7 @@ pub fn broadcast_cameras(
                     sy = sy.max((c.y / c.z).abs());
                 }
             }
-            let focal = (0.4 * width as f64 / sx).min(0.4 * height as f64 / sy);
+            let focal = (0.425 * width as f64 / sx).min(0.425 * height as f64 / sy);
             let cam = Camera {
                 k1: -0.02,
                 ..Camera::looking_at_up(eye, centre, Vec3::z(), focal, width, height)
@@ -422,7 +423,7 @@ pub fn make_golf_sequence(
             "fit_every": options.fit_every,
             "fit_residual_rms_mm": fit.rms() * 1e3,
             "club_length": club.length,
-            "proportions": proportions_json(&proportions),
+            "proportions": proportions.to_json(),
         },
     });
     let meta_path = out.join("sequence.json");
@@ -526,12 +527,4 @@ fn write_ground_truth(
     }
     let path = out.join("club.csv");
     std::fs::write(&path, csv).map_err(io_err(&path))
-}
-
-fn proportions_json(p: &Proportions) -> serde_json::Value {
-    serde_json::json!({
-        "torso": p.torso, "neck": p.neck, "head": p.head, "upper_arm": p.upper_arm,
-        "forearm": p.forearm, "hand": p.hand, "thigh": p.thigh, "shin": p.shin,
-        "foot": p.foot, "girth": p.girth,
-    })
 }

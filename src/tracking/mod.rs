@@ -18,6 +18,7 @@
 
 pub mod annealing;
 pub mod auto_start;
+pub mod body_adapt;
 pub mod bvh_export;
 pub mod calibration;
 pub mod checkpoint;

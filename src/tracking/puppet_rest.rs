@@ -59,6 +59,53 @@ impl Default for Proportions {
     }
 }
 
+impl Proportions {
+    /// The ten values with their names, in field order (for files and scripts).
+    pub fn named(&self) -> [(&'static str, f64); 10] {
+        [
+            ("torso", self.torso),
+            ("neck", self.neck),
+            ("head", self.head),
+            ("upper_arm", self.upper_arm),
+            ("forearm", self.forearm),
+            ("hand", self.hand),
+            ("thigh", self.thigh),
+            ("shin", self.shin),
+            ("foot", self.foot),
+            ("girth", self.girth),
+        ]
+    }
+
+    /// Proportions from the ten values of [`Proportions::named`], in its order; `None` for
+    /// another count.
+    pub fn from_values(v: &[f64]) -> Option<Proportions> {
+        let &[torso, neck, head, upper_arm, forearm, hand, thigh, shin, foot, girth] = v else {
+            return None;
+        };
+        Some(Proportions {
+            torso,
+            neck,
+            head,
+            upper_arm,
+            forearm,
+            hand,
+            thigh,
+            shin,
+            foot,
+            girth,
+        })
+    }
+
+    /// As a JSON object of the named values.
+    pub fn to_json(&self) -> serde_json::Value {
+        self.named()
+            .iter()
+            .map(|(k, v)| (k.to_string(), serde_json::json!(v)))
+            .collect::<serde_json::Map<_, _>>()
+            .into()
+    }
+}
+
 /// Segments scaled by [`Proportions`]; every bone belongs to the segment of its nearest
 /// ancestor-or-self among the key bones.
 #[derive(Clone, Copy, Debug, PartialEq)]

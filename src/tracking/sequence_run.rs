@@ -91,7 +91,7 @@ pub fn track_sequence_from(
             let t_io = Instant::now();
             let images = seq.frame_images(f0)?;
             result.io_seconds += t_io.elapsed().as_secs_f64();
-            let first = match approx {
+            let mut first = match approx {
                 Some(approx) => tracker.start(&images, approx)?,
                 None => tracker.start_auto(&images).map_err(|e| {
                     TrackError::Invalid(format!(
@@ -100,6 +100,11 @@ pub fn track_sequence_from(
                     ))
                 })?,
             };
+            if options.adapt_body {
+                let (pose, proportions) = tracker.adapt_start(&first)?;
+                first = pose;
+                result.proportions = Some(proportions);
+            }
             result.first_frame = f0;
             result.overlaps.push(tracker.overlap(&first));
             tracker.stage_seconds.iter_mut().for_each(|s| *s = 0.0);

@@ -88,6 +88,7 @@ pub fn summary_json(seq: &Sequence, result: &TrackResult) -> String {
         "seconds_per_frame_by_stage": stages,
         "io_seconds_per_frame": result.io_seconds / result.joints.len().max(1) as f64,
         "start_seconds": result.start_seconds,
+        "proportions": result.proportions.map(|p| p.to_json()),
         "evaluations_per_frame": result.evaluations as f64 / result.frame_seconds.len().max(1) as f64,
     });
     serde_json::to_string_pretty(&v).unwrap_or_default()

@@ -83,6 +83,8 @@ pub struct TrackerOptions {
     pub recover: bool,
     /// First frame tracked (the start is made there).
     pub first_frame: usize,
+    /// Adapt the puppet's proportions to the person at the start ([`super::body_adapt`]).
+    pub adapt_body: bool,
 }
 
 impl Default for TrackerOptions {
@@ -103,6 +105,7 @@ impl Default for TrackerOptions {
             auto_start: false,
             recover: false,
             first_frame: 0,
+            adapt_body: false,
         }
     }
 }
@@ -136,6 +139,8 @@ pub struct TrackResult {
     pub errors_mm: Option<Vec<f64>>,
     /// Per-frame, per-joint errors (mm), when the ground truth is present.
     pub joint_errors_mm: Option<Vec<[f64; JOINT_COUNT]>>,
+    /// The puppet's proportions found by the body adaptation, when it ran.
+    pub proportions: Option<super::puppet::Proportions>,
 }
 
 impl TrackResult {
@@ -222,7 +227,10 @@ fn move_sigma(k: usize, group: PartGroup) -> f64 {
 
 /// The tracker's state between frames.
 pub struct Tracker {
-    puppet: Puppet,
+    pub(super) puppet: Puppet,
+    /// The body model the puppet and its mesh are built on (kept to rebuild them with other
+    /// proportions, [`super::body_adapt`]).
+    pub(super) mannequin: Mannequin,
     pub(super) mesh: TrackingMesh,
     pub(super) colours: Option<Vec<[f32; 3]>>,
     pub(super) views: FrameViews,
@@ -291,6 +299,7 @@ impl Tracker {
         Ok(Tracker {
             rng: SplitMix64::new(options.seed),
             puppet,
+            mannequin: mannequin.clone(),
             mesh,
             colours: None,
             views,
@@ -307,6 +316,27 @@ impl Tracker {
     /// The puppet.
     pub fn puppet(&self) -> &Puppet {
         &self.puppet
+    }
+
+    /// Rebuilds the puppet, its mesh and the cost workspaces with body proportions `p`
+    /// (relative to the mannequin); learnt colours are dropped (the mesh changes).
+    pub fn set_proportions(&mut self, p: &super::puppet::Proportions) -> Result<(), TrackError> {
+        let puppet = Puppet::new(&self.mannequin)
+            .and_then(|b| b.with_proportions(p))
+            .map_err(|e| TrackError::Puppet(e.to_string()))?;
+        self.mesh = TrackingMesh::build(&self.mannequin, &puppet, self.options.mesh_cell);
+        self.puppet = puppet;
+        let bones = self.mannequin.skeleton().len();
+        let n = self.mesh.rest.len();
+        for w in &self.workspaces {
+            let mut w = match w.lock() {
+                Ok(g) => g,
+                Err(poisoned) => poisoned.into_inner(),
+            };
+            *w = CostWorkspace::new(&self.views, bones, n);
+        }
+        self.colours = None;
+        Ok(())
     }
 
     /// Runs the stages on the current frame from `start` (move spreads scaled by
