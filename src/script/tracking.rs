@@ -79,6 +79,8 @@ fn options(m: &Map) -> RResult<(TrackerOptions, TrackOutputOptions, Option<Strin
             }
             "first_frame" => o.first_frame = count(v, "first_frame")?,
             "adapt_body" => o.adapt_body = flag(v, "adapt_body")?,
+            "torso_spread" => o.torso_spread = finite(v, "torso_spread")?,
+            "anchor_limbs" => o.anchor_limbs = flag(v, "anchor_limbs")?,
             "frames" => o.frames = Some(count(v, "frames")?),
             "overlay_every" => out.overlay_every = count(v, "overlay_every")?,
             "makehuman" => makehuman = Some(v.to_string()),
@@ -86,7 +88,7 @@ fn options(m: &Map) -> RResult<(TrackerOptions, TrackOutputOptions, Option<Strin
                 return Err(rt_err(format!(
                 "track_body: unknown option `{other}` (particles, layers, passes, robust_sigma, \
                      mesh_cell, lbs, background_frames, prediction, prior_weight, limb_restarts, seed, \
-                     init, recover, first_frame, frames, \
+                     init, recover, first_frame, frames, adapt_body, torso_spread, anchor_limbs, \
                      overlay_every, makehuman)"
             )))
             }
@@ -223,7 +225,11 @@ default 0.05), `limb_restarts` (limb stages also start from the previous,
 the rest, a half-bent and a straightened limb pose; default true), `seed`, `frames` (track only the first
 frames), `init` (`joints`: start from `init_joints.csv`; `auto`: find the person and
 the pose from the first frame's images alone), `first_frame` (start there; needs `init: \"auto\"`),
-`recover` (notice a lost track and search the body again; default false), `passes` (spread factor of each pass of the stage hierarchy per frame, e.g. [1.0, 0.35]),
+`recover` (notice a lost track and search the body again; default false), `adapt_body`
+(fit the puppet's segment lengths and girth to the person's silhouettes at the start;
+default false), `torso_spread` (move spread of the pelvis and chest rotations, radians,
+default 0.08), `anchor_limbs` (the trunk stage keeps the upper arms and thighs still in
+the world; default false), `passes` (spread factor of each pass of the stage hierarchy per frame, e.g. [1.0, 0.35]),
 `overlay_every` (0: no pictures), `makehuman` (folder of the body model).",
         |seq: &str, out: &str, m: Map| track(seq, out, &m)
     );

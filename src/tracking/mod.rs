@@ -9,11 +9,14 @@
 //! - [`joints`]: the sixteen tracking joints on the MakeHuman skeleton, and the error measure;
 //! - [`puppet`], [`puppet_mesh`]: the tracking puppet (pose parameters with joint limits,
 //!   forward kinematics onto the MakeHuman skeleton) and its light mesh for rendering;
-//! - [`clothing`], [`sequence`], [`sequence_files`]: synthetic multi-camera sequences with
-//!   ground truth, and reading any sequence folder;
+//! - [`clothing`], [`sequence`], [`sequence_render`], [`sequence_files`]: synthetic
+//!   multi-camera sequences with ground truth, and reading any sequence folder;
+//! - [`golf_sequence`], [`club_mesh`]: broadcast sequences of a captured golf swing;
+//!   [`golf_track`]: the tracked swing's golf metrics against the truth;
 //! - [`pyramid`], [`texture`], [`cost`], [`annealing`], [`restarts`], [`tracker`]: the tracker;
 //! - [`visual_hull`], [`auto_start`], [`loss`]: finding the person without help (the
-//!   automatic start), noticing a lost track and finding the body again;
+//!   automatic start), noticing a lost track and finding the body again; [`body_adapt`]: the
+//!   puppet's proportions fitted to the person at the start;
 //! - [`bvh_export`], [`overlay`], [`swing_metrics`], [`track_outputs`]: its outputs.
 
 pub mod annealing;

@@ -36,10 +36,13 @@ use crate::geometry::Vec3;
 
 #[path = "puppet_fit.rs"]
 pub(crate) mod fit;
+#[path = "puppet_limbs.rs"]
+mod limbs;
 #[path = "puppet_rest.rs"]
 mod rest;
 
 pub(crate) use fit::kabsch;
+pub use limbs::LimbAnchor;
 pub use rest::Proportions;
 use rest::{right_of, Segment, KEYS};
 

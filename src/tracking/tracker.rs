@@ -28,7 +28,7 @@ use super::pyramid::{median_background, Level};
 use super::restarts::limb_restarts;
 use super::sequence_files::{Sequence, SequenceError};
 use super::texture::learn_colours;
-use crate::body::Mannequin;
+use crate::body::{Mannequin, Pose};
 use crate::geometry::{SplitMix64, Vec3};
 
 /// Errors of the tracker.
@@ -85,6 +85,12 @@ pub struct TrackerOptions {
     pub first_frame: usize,
     /// Adapt the puppet's proportions to the person at the start ([`super::body_adapt`]).
     pub adapt_body: bool,
+    /// Move spread of the pelvis and chest rotations, radians (their motion prior's scale
+    /// too). Default 0.08.
+    pub torso_spread: f64,
+    /// The trunk stage keeps the upper arms and thighs still in the world
+    /// ([`Puppet::keep_limbs`]) instead of carrying them with the trunk. Default false.
+    pub anchor_limbs: bool,
 }
 
 impl Default for TrackerOptions {
@@ -106,6 +112,8 @@ impl Default for TrackerOptions {
             recover: false,
             first_frame: 0,
             adapt_body: false,
+            torso_spread: 0.08,
+            anchor_limbs: false,
         }
     }
 }
@@ -213,11 +221,12 @@ pub(super) const STAGES: &[Stage] = &[
     },
 ];
 
-/// Initial move spread of parameter `k` (metres for the root translation, radians else).
-fn move_sigma(k: usize, group: PartGroup) -> f64 {
+/// Initial move spread of parameter `k` (metres for the root translation, radians else;
+/// `torso` for the pelvis and chest rotations).
+fn move_sigma(k: usize, group: PartGroup, torso: f64) -> f64 {
     match group {
         PartGroup::Root if k < 3 => 0.03,
-        PartGroup::Root | PartGroup::Torso => 0.08,
+        PartGroup::Root | PartGroup::Torso => torso,
         PartGroup::Head => 0.15,
         PartGroup::LeftArm | PartGroup::RightArm => 0.25,
         PartGroup::LeftLeg | PartGroup::RightLeg => 0.2,
@@ -266,6 +275,12 @@ impl Tracker {
             return Err(TrackError::Invalid(
                 "tracker: robust_sigma and mesh_cell must be positive".into(),
             ));
+        }
+        if !(options.torso_spread.is_finite() && options.torso_spread > 0.0) {
+            return Err(TrackError::Invalid(format!(
+                "tracker: torso_spread must be positive (got {})",
+                options.torso_spread
+            )));
         }
         if !(options.prior_weight.is_finite() && options.prior_weight >= 0.0) {
             return Err(TrackError::Invalid(format!(
@@ -375,7 +390,7 @@ impl Tracker {
             }
             let spread: Vec<f64> = dofs
                 .iter()
-                .map(|&k| move_sigma(k, infos[k].group))
+                .map(|&k| move_sigma(k, infos[k].group, self.options.torso_spread))
                 .collect();
             // limbs move fastest and are the most often hidden: half as many particles again
             settings.particles = if s >= 2 {
@@ -406,13 +421,21 @@ impl Tracker {
             let views = &self.views;
             let workspaces = &self.workspaces;
             let puppet = &self.puppet;
+            // the trunk stage may keep the limbs still in the world
+            let anchor = (s == 0 && self.options.anchor_limbs).then(|| puppet.limb_anchor(&params));
+            let scratch = std::cell::RefCell::new(Pose::identity(0));
             let r = anneal(
                 &params,
                 &dofs,
                 &sigma,
                 &settings,
                 &mut self.rng,
-                |p| puppet.clamp(p),
+                |p| {
+                    if let Some(a) = &anchor {
+                        puppet.keep_limbs(p, a, &mut scratch.borrow_mut());
+                    }
+                    puppet.clamp(p)
+                },
                 |p, level| {
                     let slot = rayon::current_thread_index().unwrap_or(workspaces.len() - 1);
                     let mut ws = match workspaces[slot.min(workspaces.len() - 1)].lock() {
