@@ -45,7 +45,7 @@ const QUICK: &[(&str, &[&str])] = &[
             "cameras=1",
         ],
     ),
-    ("golf_track", &["frames=2"]),
+    ("golf_track", &["frames=2", "adapt_body=false"]),
     ("facades_eval", &["limit=2"]),
     ("all", &["meshes=coarse", "limit=1"]),
     ("bending", &["meshes=coarse"]),

@@ -44,6 +44,36 @@ pub fn limb_restarts(
     }
 }
 
+/// Turns of the pelvis about the vertical tried by [`trunk_restarts`] (radians).
+const TRUNK_TURNS: [f64; 6] = [-0.8, -0.4, -0.2, 0.2, 0.4, 0.8];
+/// Chest twists tried by [`trunk_restarts`] (radians, added to the current twist).
+const CHEST_TWISTS: [f64; 2] = [-0.35, 0.35];
+/// Index of the chest's twist parameter (`spine02`, its `y` component).
+const CHEST_TWIST: usize = 7;
+
+/// Alternative starting points of the trunk stage: the pelvis turned about the vertical by
+/// each of [`TRUNK_TURNS`], and the chest twisted by each of [`CHEST_TWISTS`]. A trunk that
+/// turns fast (a golf downswing: the shoulders 15° a frame, reversing at the top) leaves the
+/// prediction behind; with the limbs anchored in the world
+/// ([`Puppet::keep_limbs`](super::puppet::Puppet::keep_limbs)) these starts let the
+/// annealing reach it.
+pub fn trunk_restarts(current: &[f64], out: &mut Vec<Vec<f64>>) {
+    let root = nalgebra::UnitQuaternion::from_scaled_axis(nalgebra::Vector3::new(
+        current[3], current[4], current[5],
+    ));
+    for turn in TRUNK_TURNS {
+        let r = nalgebra::UnitQuaternion::from_scaled_axis(nalgebra::Vector3::z() * turn) * root;
+        let mut p = current.to_vec();
+        p[3..6].copy_from_slice(r.scaled_axis().as_slice());
+        out.push(p);
+    }
+    for twist in CHEST_TWISTS {
+        let mut p = current.to_vec();
+        p[CHEST_TWIST] += twist;
+        out.push(p);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -80,5 +110,30 @@ mod tests {
         limb_restarts(&infos, &current, &[3], &previous, &mut out);
         assert_eq!(out[2], vec![0.4, -0.1, 0.2, BENT_ELBOW]);
         assert_eq!(out[3], vec![0.4, -0.1, 0.2, 0.0]);
+    }
+
+    #[test]
+    fn trunk_restarts_turn_the_pelvis_about_the_vertical_and_twist_the_chest() {
+        let mut current = vec![0.0; 48];
+        current[3..6].copy_from_slice(&[0.3, -0.2, 1.1]); // a tilted, turned pelvis
+        current[CHEST_TWIST] = 0.1;
+        let mut out = Vec::new();
+        trunk_restarts(&current, &mut out);
+        assert_eq!(out.len(), TRUNK_TURNS.len() + CHEST_TWISTS.len());
+        let q = |p: &[f64]| {
+            nalgebra::UnitQuaternion::from_scaled_axis(nalgebra::Vector3::new(p[3], p[4], p[5]))
+        };
+        for (p, turn) in out.iter().zip(TRUNK_TURNS) {
+            // the seed's pelvis is the current one turned by `turn` about world z
+            let d = q(p) * q(&current).inverse();
+            let expected =
+                nalgebra::UnitQuaternion::from_scaled_axis(nalgebra::Vector3::z() * turn);
+            assert!(d.angle_to(&expected) < 1e-12, "{turn}");
+            assert_eq!(p[CHEST_TWIST], 0.1);
+        }
+        for (p, twist) in out[TRUNK_TURNS.len()..].iter().zip(CHEST_TWISTS) {
+            assert!((p[CHEST_TWIST] - 0.1 - twist).abs() < 1e-15);
+            assert_eq!(p[3..6], current[3..6]);
+        }
     }
 }

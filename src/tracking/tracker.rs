@@ -25,7 +25,7 @@ use super::joints::JOINT_COUNT;
 use super::puppet::{PartGroup, Puppet};
 use super::puppet_mesh::TrackingMesh;
 use super::pyramid::{median_background, Level};
-use super::restarts::limb_restarts;
+use super::restarts::{limb_restarts, trunk_restarts};
 use super::sequence_files::{Sequence, SequenceError};
 use super::texture::learn_colours;
 use crate::body::{Mannequin, Pose};
@@ -89,7 +89,8 @@ pub struct TrackerOptions {
     /// too). Default 0.08.
     pub torso_spread: f64,
     /// The trunk stage keeps the upper arms and thighs still in the world
-    /// ([`Puppet::keep_limbs`]) instead of carrying them with the trunk. Default false.
+    /// ([`Puppet::keep_limbs`]) instead of carrying them with the trunk, and also starts from
+    /// the pelvis turned and the chest twisted ([`trunk_restarts`]). Default false.
     pub anchor_limbs: bool,
 }
 
@@ -411,6 +412,9 @@ impl Tracker {
             }
             if s >= 2 {
                 settings.seeds.extend(self.extra_seeds.iter().cloned());
+            }
+            if s == 0 && self.options.anchor_limbs && !self.history.is_empty() {
+                trunk_restarts(&params, &mut settings.seeds);
             }
             let app = Appearance {
                 puppet: &self.puppet,
