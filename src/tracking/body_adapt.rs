@@ -6,7 +6,7 @@
 //! Each candidate rebuilds the puppet and its mesh ([`Tracker::set_proportions`]) and runs the
 //! tracker's annealing from the current pose at narrow moves, with the image cost of the
 //! silhouettes only (colours are learnt after the body is settled). Every candidate's
-//! annealing draws the same random numbers ([`EVAL_SEED`]), so two bodies are compared on the
+//! annealing draws the same random numbers (one fixed seed), so two bodies are compared on the
 //! same particles and a change is kept only when it fits better. Steps of 8, 4 and 2 % per
 //! field; a field moves at most once per step size and direction tried.
 

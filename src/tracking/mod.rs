@@ -47,6 +47,7 @@ pub mod pyramid;
 pub mod restarts;
 pub mod sequence;
 pub mod sequence_files;
+pub mod sequence_options;
 pub mod sequence_render;
 pub mod sequence_run;
 pub mod swing_metrics;

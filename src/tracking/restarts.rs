@@ -52,7 +52,7 @@ const CHEST_TWISTS: [f64; 2] = [-0.35, 0.35];
 const CHEST_TWIST: usize = 7;
 
 /// Alternative starting points of the trunk stage: the pelvis turned about the vertical by
-/// each of [`TRUNK_TURNS`], and the chest twisted by each of [`CHEST_TWISTS`]. A trunk that
+/// ±0.2, ±0.4 and ±0.8 rad, and the chest twisted by ±0.35 rad. A trunk that
 /// turns fast (a golf downswing: the shoulders 15° a frame, reversing at the top) leaves the
 /// prediction behind; with the limbs anchored in the world
 /// ([`Puppet::keep_limbs`](super::puppet::Puppet::keep_limbs)) these starts let the

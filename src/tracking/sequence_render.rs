@@ -12,9 +12,10 @@ use std::path::{Path, PathBuf};
 
 use image::RgbImage;
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
-use super::sequence::{Occluder, SequenceOptions};
 use super::sequence_files::{cover, image_path, io_err, list_photos, write_png, SequenceError};
+use super::sequence_options::SequenceOptions;
 use crate::geometry::Camera;
 use crate::geometry::{SplitMix64, Vec3};
 use crate::render::raster::{draw_triangles, project_vertices, RasterTarget};
@@ -29,6 +30,31 @@ pub struct SceneMesh {
     pub colours: Vec<[f32; 3]>,
     /// Triangles (vertex indices).
     pub triangles: Vec<[u32; 3]>,
+}
+
+/// A static occluding rectangle `[x0, x1) × [y0, y1)` in pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Occluder {
+    /// Left column.
+    pub x0: u32,
+    /// Top row.
+    pub y0: u32,
+    /// Right end (exclusive).
+    pub x1: u32,
+    /// Bottom end (exclusive).
+    pub y1: u32,
+}
+
+impl Occluder {
+    /// Whether pixel `(x, y)` is covered.
+    pub fn contains(&self, x: u32, y: u32) -> bool {
+        x >= self.x0 && x < self.x1 && y >= self.y0 && y < self.y1
+    }
+
+    /// Covered pixels.
+    pub fn area(&self) -> u64 {
+        u64::from(self.x1 - self.x0) * u64::from(self.y1 - self.y0)
+    }
 }
 
 /// Everything fixed about one camera, and its reusable render buffers.
