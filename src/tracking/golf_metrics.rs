@@ -206,7 +206,8 @@ pub fn golf_metrics_csv(m: &GolfMetrics) -> String {
     s
 }
 
-fn series(name: &str, time: &[f64], values: &[f64]) -> Series {
+/// A plot series of the finite `values` against `time`.
+pub(crate) fn series(name: &str, time: &[f64], values: &[f64], style: SeriesStyle) -> Series {
     Series {
         name: name.to_string(),
         points: time
@@ -215,7 +216,7 @@ fn series(name: &str, time: &[f64], values: &[f64]) -> Series {
             .filter(|(_, v)| v.is_finite())
             .map(|(&t, &v)| [t, v])
             .collect(),
-        style: SeriesStyle::Solid,
+        style,
     }
 }
 
@@ -244,15 +245,25 @@ pub fn write_golf_metrics(
         x_label: "time (s)".to_string(),
         y_label: "rotation about z (°)".to_string(),
         series: vec![
-            series("pelvis", t, &m.swing.pelvis_deg),
-            series("shoulders", t, &m.swing.shoulder_deg),
-            series("X-factor", t, &m.swing.x_factor_deg),
+            series("pelvis", t, &m.swing.pelvis_deg, SeriesStyle::Solid),
+            series("shoulders", t, &m.swing.shoulder_deg, SeriesStyle::Solid),
+            series("X-factor", t, &m.swing.x_factor_deg, SeriesStyle::Solid),
         ],
     };
     let (rp, rs) = write_plot_pair(&dir.join(format!("{stem}_rotation")), &rotation)?;
-    let mut speed = vec![series("lead wrist", t, &m.lead_wrist_speed)];
+    let mut speed = vec![series(
+        "lead wrist",
+        t,
+        &m.lead_wrist_speed,
+        SeriesStyle::Solid,
+    )];
     if m.clubhead_speed.iter().any(|v| v.is_finite()) {
-        speed.push(series("club head", t, &m.clubhead_speed));
+        speed.push(series(
+            "club head",
+            t,
+            &m.clubhead_speed,
+            SeriesStyle::Solid,
+        ));
     }
     let speeds = PlotSpec {
         title: "Lead wrist and club-head speed".to_string(),

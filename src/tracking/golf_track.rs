@@ -9,11 +9,11 @@ use std::path::{Path, PathBuf};
 
 use super::bvh_export::{io_error, TrackingOutputError};
 use super::club::ClubFit;
-use super::golf_metrics::{golf_metrics, write_golf_metrics, GolfMetrics};
+use super::golf_metrics::{golf_metrics, series, write_golf_metrics, GolfMetrics};
 use super::joints::JOINT_COUNT;
 use super::sequence_files::{read_joints_csv, Sequence};
 use crate::geometry::Vec3;
-use crate::render::plot::{write_plot_pair, PlotSpec, Series, SeriesStyle};
+use crate::render::plot::{write_plot_pair, PlotSpec, SeriesStyle};
 
 /// Truth against tracking, for one sequence.
 #[derive(Clone, Debug)]
@@ -81,19 +81,6 @@ fn read_club(path: &Path, rate: f64) -> Result<Option<ClubFit>, TrackingOutputEr
         length: f64::NAN,
         grip_rms: f64::NAN,
     }))
-}
-
-fn series(name: &str, time: &[f64], values: &[f64], style: SeriesStyle) -> Series {
-    Series {
-        name: name.to_string(),
-        points: time
-            .iter()
-            .zip(values)
-            .filter(|(_, v)| v.is_finite())
-            .map(|(&t, &v)| [t, v])
-            .collect(),
-        style,
-    }
 }
 
 /// Compares the tracked joints in `tracked_dir/tracked_joints.csv` with the ground truth of
