@@ -46,4 +46,30 @@ impl Mannequin {
         m.skeleton.map_points(map);
         Ok(m)
     }
+
+    /// This mannequin with its skin at `rest` instead (another person's rest skin, one
+    /// position per skin vertex, e.g. a reshaped puppet's), the skeleton and helper vertices
+    /// kept: a body to dress at rest, not to animate with this mannequin's skeleton. An error
+    /// names a wrong vertex count or a non-finite position.
+    pub fn with_rest_skin(&self, rest: &[Vec3]) -> Result<Mannequin, BodyError> {
+        if rest.len() != self.rest.len() {
+            return Err(BodyError::invalid(
+                "mannequin skin",
+                format!(
+                    "{} positions given, the skin has {}",
+                    rest.len(),
+                    self.rest.len()
+                ),
+            ));
+        }
+        if let Some(i) = rest.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+            return Err(BodyError::invalid(
+                "mannequin skin",
+                format!("position {i} is not finite"),
+            ));
+        }
+        let mut m = self.clone();
+        m.rest.copy_from_slice(rest);
+        Ok(m)
+    }
 }

@@ -3,7 +3,7 @@
 use rhai::{Dynamic, Map, INT};
 
 use super::convert::{rt_err, RResult};
-use super::paths::{read_folder, read_folder_opt, write_folder};
+use super::paths::{read_folder, read_folder_opt, read_path, write_folder};
 use super::tracking_sequence::{apply_options, number, whole};
 use super::{function, modules::ApiBuilder};
 use crate::body::Mannequin;
@@ -12,6 +12,7 @@ use crate::tracking::golf_sequence::{make_golf_sequence, GolfSequenceOptions};
 use crate::tracking::golf_track::golf_report;
 use crate::tracking::golf_trial::run_golf_trial;
 use crate::tracking::marker_fit::MarkerFitOptions;
+use crate::tracking::sequence_dressing::DressingOptions;
 use crate::tracking::sequence_files::Sequence;
 
 fn golf(c3d: &str, out: &str, m: &Map) -> RResult<Map> {
@@ -71,7 +72,46 @@ fn golf(c3d: &str, out: &str, m: &Map) -> RResult<Map> {
 }
 
 /// Option keys of `track::golf_sequence` besides the sequence's own.
-const GOLF_KEYS: [&str; 6] = ["shutter", "blur", "reshape", "every", "stride", "rounds"];
+const GOLF_KEYS: [&str; 11] = [
+    "shutter", "blur", "reshape", "every", "stride", "rounds", "garments", "fabric", "edge",
+    "cloth_dt", "lead_in",
+];
+
+/// The dressing of `track::golf_sequence`: `garments` (an array of garment-table paths;
+/// absent or empty: not dressed), `fabric` (a fabric file, required with garments), `edge`,
+/// `cloth_dt`, `lead_in`.
+fn dressing_options(m: &Map) -> RResult<Option<DressingOptions>> {
+    let garments = match m.get("garments") {
+        None => return Ok(None),
+        Some(g) => g.clone().into_array().map_err(|t| {
+            rt_err(format!(
+                "golf_sequence: `garments` must be an array of paths, got {t}"
+            ))
+        })?,
+    };
+    if garments.is_empty() {
+        return Ok(None);
+    }
+    let paths = garments
+        .into_iter()
+        .map(|g| read_path(&g.to_string()))
+        .collect::<RResult<Vec<_>>>()?;
+    let fabric = m
+        .get("fabric")
+        .ok_or_else(|| rt_err("golf_sequence: `garments` needs `fabric` (a fabric file)"))?;
+    let mut d = DressingOptions::new(paths, read_path(&fabric.to_string())?);
+    let get = |k: &str| m.get(k).map(|v| number(v, k)).transpose();
+    if let Some(v) = get("edge")? {
+        d.edge = v;
+    }
+    if let Some(v) = get("cloth_dt")? {
+        d.dt = v;
+    }
+    if let Some(v) = get("lead_in")? {
+        d.lead_in = v;
+    }
+    Ok(Some(d))
+}
 
 fn golf_sequence(c3d: &str, out: &str, m: &Map) -> RResult<Map> {
     if !std::path::Path::new(c3d).is_file() {
@@ -106,6 +146,7 @@ fn golf_sequence(c3d: &str, out: &str, m: &Map) -> RResult<Map> {
     if let Some(v) = count("rounds")? {
         o.fit.rounds = v.clamp(1, 100) as usize;
     }
+    o.dressing = dressing_options(m)?;
     let s =
         make_golf_sequence(std::path::Path::new(c3d), &write_folder(out)?, &o).map_err(rt_err)?;
     let mut map = Map::new();
@@ -127,6 +168,25 @@ fn golf_sequence(c3d: &str, out: &str, m: &Map) -> RResult<Map> {
         props.insert(k.into(), fl(v));
     }
     map.insert("proportions".into(), props.into());
+    if let Some(d) = &s.dressing {
+        let mut g = Map::new();
+        g.insert("garments".into(), d.garments.join(", ").into());
+        g.insert("vertices".into(), Dynamic::from_int(d.vertices as INT));
+        g.insert("dress_seconds".into(), fl(d.dress_seconds));
+        g.insert("motion_seconds".into(), fl(d.motion_seconds));
+        g.insert("steps".into(), Dynamic::from_int(d.steps as INT));
+        g.insert(
+            "checked_frames".into(),
+            Dynamic::from_int(d.checked_frames as INT),
+        );
+        g.insert(
+            "worst_penetrating".into(),
+            Dynamic::from_int(d.worst_penetrating as INT),
+        );
+        g.insert("min_distance_mm".into(), fl(d.min_distance * 1e3));
+        g.insert("max_distance_mm".into(), fl(d.max_distance * 1e3));
+        map.insert("dressing".into(), g.into());
+    }
     Ok(map)
 }
 
@@ -197,7 +257,14 @@ the whole swing) in front of real photos, with motion blur (`shutter` seconds, d
 golf metrics). Options: those of `track::make_sequence` (`cameras` ≤ 4, `width`, `height`,
 `fps`, `frames`, `start`, `noise`, `lighting`, `occluder`, `seed`, `backgrounds`,
 `makehuman`, `shading`) and `shutter`, `blur`, `reshape`, `every` (fit every n-th
-capture frame, default 2), `stride` (calibration frames, 8), `rounds` (3). A missing `c3d`
+capture frame, default 2), `stride` (calibration frames, 8), `rounds` (3). Dressed with
+`garments` (garment tables, e.g. `[\"patterns/aaron.garment.json\",
+\"patterns/paco.garment.json\"]`) and `fabric` (a fabric file): each garment is sewn and
+draped on the golfer at rest, carried into the swing and simulated through it (`edge`: mesh
+edge, default 0.02 m; `cloth_dt`: step, 1/240 s; `lead_in`: swing played before the first
+frame, 0.8 s); the result then holds `dressing` #{garments, vertices, dress_seconds,
+motion_seconds, steps, checked_frames, worst_penetrating (most garment vertices inside the
+body at a frame), min_distance_mm, max_distance_mm}. A missing `c3d`
 file returns #{skipped: message}. Returns #{dir, frames, cameras, width, height, seconds,
 seconds_per_frame, fit_residual_rms_mm, lead_wrist_peak_mps, clubhead_peak_mps,
 xfactor_peak_deg, proportions}.",

@@ -157,38 +157,75 @@ pub fn dominant_bone(mannequin: &Mannequin, v: usize) -> usize {
 /// position: striped shirt, sleeves of another colour, skin, hair, trousers with a subtle
 /// check, dark shoes. The palette and stripe width come from `seed`; deterministic.
 pub fn clothing_colours(mannequin: &Mannequin, seed: u64) -> Vec<[f32; 3]> {
-    let mut rng = SplitMix64::new(seed ^ 0xC107_41E5_0000_0001);
-    let (shirt_a, shirt_b) = SHIRTS[rng.below(SHIRTS.len())];
-    let sleeve = SLEEVES[rng.below(SLEEVES.len())];
-    let skin = SKINS[rng.below(SKINS.len())];
-    let hair = HAIRS[rng.below(HAIRS.len())];
-    let trousers = TROUSERS[rng.below(TROUSERS.len())];
-    let stripe = rng.range(0.025, 0.045);
-    let check = 0.02;
-    let scale = |c: [f32; 3], f: f32| [c[0] * f, c[1] * f, c[2] * f];
+    let palette = Palette::of(seed);
     garments(mannequin)
         .iter()
         .zip(mannequin.rest_positions())
-        .map(|(g, p)| match g {
+        .map(|(g, p)| palette.colour(*g, *p))
+        .collect()
+}
+
+/// The colours of one seeded outfit (what [`clothing_colours`] paints on the skin, and the
+/// colours of simulated garments over it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Palette {
+    shirt: ([f32; 3], [f32; 3]),
+    sleeve: [f32; 3],
+    skin: [f32; 3],
+    hair: [f32; 3],
+    trousers: [f32; 3],
+    /// Height of a shirt stripe (m).
+    stripe: f64,
+}
+
+impl Palette {
+    /// The outfit drawn from `seed`.
+    pub fn of(seed: u64) -> Palette {
+        let mut rng = SplitMix64::new(seed ^ 0xC107_41E5_0000_0001);
+        let shirt = SHIRTS[rng.below(SHIRTS.len())];
+        let sleeve = SLEEVES[rng.below(SLEEVES.len())];
+        let skin = SKINS[rng.below(SKINS.len())];
+        let hair = HAIRS[rng.below(HAIRS.len())];
+        let trousers = TROUSERS[rng.below(TROUSERS.len())];
+        let stripe = rng.range(0.025, 0.045);
+        Palette {
+            shirt,
+            sleeve,
+            skin,
+            hair,
+            trousers,
+            stripe,
+        }
+    }
+
+    /// The colour of `garment` at rest position `p` (stripes across the shirt by height, a
+    /// subtle check on the trousers).
+    pub fn colour(&self, garment: Garment, p: Vec3) -> [f32; 3] {
+        let check = 0.02;
+        let scale = |c: [f32; 3], f: f32| [c[0] * f, c[1] * f, c[2] * f];
+        match garment {
             Garment::Shirt => {
-                if (p.z / stripe).floor() as i64 % 2 == 0 {
-                    shirt_a
+                if (p.z / self.stripe).floor() as i64 % 2 == 0 {
+                    self.shirt.0
                 } else {
-                    shirt_b
+                    self.shirt.1
                 }
             }
-            Garment::Sleeve => sleeve,
-            Garment::Skin => skin,
-            Garment::Hair => hair,
+            Garment::Sleeve => self.sleeve,
+            Garment::Skin => self.skin,
+            Garment::Hair => self.hair,
             Garment::Trousers => {
                 let cell = (p.x / check).floor() as i64
                     + (p.y / check).floor() as i64
                     + (p.z / check).floor() as i64;
-                scale(trousers, if cell.rem_euclid(2) == 0 { 0.92 } else { 1.08 })
+                scale(
+                    self.trousers,
+                    if cell.rem_euclid(2) == 0 { 0.92 } else { 1.08 },
+                )
             }
             Garment::Shoes => SHOES,
-        })
-        .collect()
+        }
+    }
 }
 
 /// Skin vertex positions under `pose`: linear blending, or rigid by dominant bone.

@@ -27,9 +27,10 @@
 //! ```
 
 use std::path::Path;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-use super::clothing::{clothing_colours, shaded_colours};
+use super::clothing::{clothing_colours, shaded_colours, Palette};
 use super::club::{fit_club, ClubFit, GEARS_CLUB};
 use super::club_mesh::ClubMesh;
 use super::golf_metrics::{golf_metrics, write_golf_metrics, GolfMetrics};
@@ -38,6 +39,7 @@ use super::marker_fit::{fit_markers, MarkerFitOptions};
 use super::marker_set::MarkerSet;
 use super::puppet::{Proportions, Puppet};
 use super::sequence::{SequenceOptions, SequenceSummary};
+use super::sequence_dressing::{BodyMotion, DressingOptions, Wardrobe, WardrobeReport};
 use super::sequence_files::{io_err, write_joints_csv, SequenceError};
 use super::sequence_render::{mix, SceneMesh, SequenceWriter};
 use crate::body::{read_c3d, Mannequin, Pose};
@@ -69,6 +71,9 @@ pub struct GolfSequenceOptions {
     pub fit_every: usize,
     /// The marker fit's settings. Default: stride 8, 3 rounds.
     pub fit: MarkerFitOptions,
+    /// Garments sewn on the golfer and simulated through the swing
+    /// ([`super::sequence_dressing`]); `None`: the clothes painted on the skin only.
+    pub dressing: Option<DressingOptions>,
 }
 
 impl Default for GolfSequenceOptions {
@@ -90,6 +95,7 @@ impl Default for GolfSequenceOptions {
                 rounds: 3,
                 ..MarkerFitOptions::default()
             },
+            dressing: None,
         }
     }
 }
@@ -122,6 +128,9 @@ impl GolfSequenceOptions {
         if !(self.reshape.is_finite() && (0.0..=0.2).contains(&self.reshape)) {
             return bad(format!("reshape must be in [0, 0.2], got {}", self.reshape));
         }
+        if let Some(d) = &self.dressing {
+            d.validate()?;
+        }
         if !(1..=60).contains(&self.fit_every) {
             return bad(format!(
                 "fit_every must be in 1..=60, got {}",
@@ -143,6 +152,8 @@ pub struct GolfSequenceSummary {
     pub fit_residual_rms: f64,
     /// The ground truth's golf metrics.
     pub truth: GolfMetrics,
+    /// The garments' figures, when dressed.
+    pub dressing: Option<WardrobeReport>,
 }
 
 /// `p` with each field multiplied by a factor drawn uniformly in `[1 − r, 1 + r]` from `rng`.
@@ -164,6 +175,7 @@ fn reshaped(p: Proportions, r: f64, rng: &mut SplitMix64) -> Proportions {
 
 /// The swing as a function of time: the fitted parameters and the club in the lead hand's
 /// rest frame, sampled at `rate`, interpolated linearly.
+#[derive(Clone)]
 struct Swing {
     rate: f64,
     params: Vec<Vec<f64>>,
@@ -399,6 +411,74 @@ pub fn make_golf_sequence(
     let metrics = golf_metrics(&joints, o.fps, Some(&truth_club));
     write_golf_metrics(out, "truth_metrics", &metrics)
         .map_err(|e| SequenceError::Options(e.to_string()))?;
+
+    // the garments, sewn at rest and carried into the swing
+    let mut wardrobe = match &options.dressing {
+        None => None,
+        Some(d) => Some(dress_golfer(&mannequin, &golfer, &swing, o, options, d)?),
+    };
+
+    // the frames: the shutter's instants, each the body, the club and the garments, shaded
+    let body_triangles: Vec<[u32; 3]> = mannequin
+        .triangles()
+        .iter()
+        .map(|t| t.map(|i| i as u32))
+        .collect();
+    let offset = colours.len() as u32;
+    let cloth_offset = offset + club_mesh.positions.len() as u32;
+    let cloth_triangles = wardrobe
+        .as_ref()
+        .map_or(Vec::new(), |w| w.triangles(cloth_offset));
+    let cloth_colours = wardrobe.as_ref().map_or(Vec::new(), |w| w.colours());
+    let triangles: Vec<[u32; 3]> = body_triangles
+        .iter()
+        .copied()
+        .chain(club_mesh.triangles.iter().map(|t| t.map(|i| i + offset)))
+        .chain(cloth_triangles)
+        .collect();
+    let base: Vec<[f32; 3]> = colours
+        .iter()
+        .chain(&club_mesh.colours)
+        .chain(&cloth_colours)
+        .copied()
+        .collect();
+    let blur = options.blur_samples;
+    let mut shutter: Vec<SceneMesh> = vec![SceneMesh::default(); blur];
+    let mut normals = Vec::new();
+    let mut skin = Vec::new();
+    for k in 0..frames {
+        for (j, scene) in shutter.iter_mut().enumerate() {
+            let phase = if blur > 1 {
+                j as f64 / (blur - 1) as f64 - 0.5
+            } else {
+                0.0
+            };
+            let t = time(k) + phase * options.shutter;
+            let (_, g, h) = at(t, Some(&mut skin));
+            club_mesh.place(g, h);
+            scene.positions.clear();
+            scene.positions.extend_from_slice(&skin);
+            scene.positions.extend_from_slice(&club_mesh.positions);
+            if let Some(w) = wardrobe.as_mut() {
+                w.positions_at(o.start_time + t, &mut scene.positions)?;
+            }
+            if scene.triangles.is_empty() {
+                scene.triangles.clone_from(&triangles);
+            }
+            shaded_colours(
+                &scene.positions,
+                &triangles,
+                &base,
+                &mut normals,
+                &mut scene.colours,
+                o.shading,
+            );
+        }
+        writer.write_frame(k, time(k), &shutter)?;
+        if let Some(w) = wardrobe.as_mut() {
+            w.check();
+        }
+    }
     let meta = serde_json::json!({
         "format": "emilion sequence",
         "version": 1,
@@ -424,6 +504,7 @@ pub fn make_golf_sequence(
             "fit_residual_rms_mm": fit.rms() * 1e3,
             "club_length": club.length,
             "proportions": proportions.to_json(),
+            "dressing": wardrobe.as_ref().map(|w| &w.report),
         },
     });
     let meta_path = out.join("sequence.json");
@@ -432,50 +513,6 @@ pub fn make_golf_sequence(
         message: e.to_string(),
     })?;
     std::fs::write(&meta_path, text + "\n").map_err(io_err(&meta_path))?;
-
-    // the frames: the shutter's instants, each the body and the club, shaded
-    let body_triangles: Vec<[u32; 3]> = mannequin
-        .triangles()
-        .iter()
-        .map(|t| t.map(|i| i as u32))
-        .collect();
-    let offset = colours.len() as u32;
-    let triangles: Vec<[u32; 3]> = body_triangles
-        .iter()
-        .copied()
-        .chain(club_mesh.triangles.iter().map(|t| t.map(|i| i + offset)))
-        .collect();
-    let base: Vec<[f32; 3]> = colours.iter().chain(&club_mesh.colours).copied().collect();
-    let blur = options.blur_samples;
-    let mut shutter: Vec<SceneMesh> = vec![SceneMesh::default(); blur];
-    let mut normals = Vec::new();
-    let mut skin = Vec::new();
-    for k in 0..frames {
-        for (j, scene) in shutter.iter_mut().enumerate() {
-            let phase = if blur > 1 {
-                j as f64 / (blur - 1) as f64 - 0.5
-            } else {
-                0.0
-            };
-            let (_, g, h) = at(time(k) + phase * options.shutter, Some(&mut skin));
-            club_mesh.place(g, h);
-            scene.positions.clear();
-            scene.positions.extend_from_slice(&skin);
-            scene.positions.extend_from_slice(&club_mesh.positions);
-            if scene.triangles.is_empty() {
-                scene.triangles.clone_from(&triangles);
-            }
-            shaded_colours(
-                &scene.positions,
-                &triangles,
-                &base,
-                &mut normals,
-                &mut scene.colours,
-                o.shading,
-            );
-        }
-        writer.write_frame(k, time(k), &shutter)?;
-    }
     let seconds = start.elapsed().as_secs_f64();
     Ok(GolfSequenceSummary {
         sequence: SequenceSummary {
@@ -490,7 +527,48 @@ pub fn make_golf_sequence(
         proportions,
         fit_residual_rms: fit.rms(),
         truth: metrics,
+        dressing: wardrobe.map(|w| w.report),
     })
+}
+
+/// The golfer's garments of `dressing`, sewn on the golfer at rest and ready to follow the
+/// swing from `lead_in` before the first frame.
+fn dress_golfer(
+    mannequin: &Mannequin,
+    golfer: &Puppet,
+    swing: &Swing,
+    o: &SequenceOptions,
+    options: &GolfSequenceOptions,
+    dressing: &DressingOptions,
+) -> Result<Wardrobe, SequenceError> {
+    let person = mannequin.with_rest_skin(golfer.rest_skin())?;
+    let start = (o.start_time - dressing.lead_in - options.shutter).max(0.0);
+    let hips = |pose: &Pose| {
+        let j = golfer.joints(pose);
+        [j[JOINT_L_HIP], j[JOINT_R_HIP]]
+    };
+    let mut params = Vec::new();
+    let mut pose = Pose::identity(golfer.bone_count());
+    let hips_rest = hips(&pose);
+    swing.at(start, &mut params);
+    golfer.pose_into(&params, &mut pose);
+    let hips_start = hips(&pose);
+    let (g, sw) = (golfer.clone(), swing.clone());
+    let scratch = Mutex::new((Vec::new(), Pose::identity(golfer.bone_count())));
+    let skin_at = move |t: f64, out: &mut Vec<Vec3>| {
+        let mut guard = scratch.lock().unwrap_or_else(|e| e.into_inner());
+        let (params, pose) = &mut *guard;
+        sw.at(t, params);
+        g.pose_into(params, pose);
+        g.skin(pose, out);
+    };
+    let motion = BodyMotion {
+        skin_at: Arc::new(skin_at),
+        start,
+        hips_rest,
+        hips_start,
+    };
+    Wardrobe::dress(&person, motion, &Palette::of(o.seed), dressing)
 }
 
 /// `ground_truth.csv`, `init_joints.csv` (frame 0 with 2 cm of seeded noise, as

@@ -11,6 +11,7 @@
 //!   forward kinematics onto the MakeHuman skeleton) and its light mesh for rendering;
 //! - [`clothing`], [`sequence`], [`sequence_render`], [`sequence_files`]: synthetic
 //!   multi-camera sequences with ground truth, and reading any sequence folder;
+//!   [`sequence_dressing`]: real garments sewn on the person and simulated through the motion;
 //! - [`golf_sequence`], [`club_mesh`]: broadcast sequences of a captured golf swing;
 //!   [`golf_track`]: the tracked swing's golf metrics against the truth;
 //! - [`pyramid`], [`texture`], [`cost`], [`annealing`], [`restarts`], [`tracker`]: the tracker;
@@ -46,6 +47,7 @@ pub mod puppet_mesh;
 pub mod pyramid;
 pub mod restarts;
 pub mod sequence;
+pub mod sequence_dressing;
 pub mod sequence_files;
 pub mod sequence_options;
 pub mod sequence_render;
