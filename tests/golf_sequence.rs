@@ -274,4 +274,9 @@ fn golf_track_script_prints_its_last_line() {
     ] {
         assert!(out.join(f).is_file(), "{f}");
     }
+    // the slow-motion broadcast animation: an animated PNG of the two frames
+    let apng = std::fs::read(out.join("broadcast.png")).unwrap();
+    let actl = apng.windows(4).position(|w| w == b"acTL").unwrap();
+    let frames = u32::from_be_bytes(apng[actl + 4..actl + 8].try_into().unwrap());
+    assert_eq!(frames, 2);
 }

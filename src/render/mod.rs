@@ -7,8 +7,10 @@
 //!   texture coordinates) that the body tracker, its synthetic sequences and the face code
 //!   draw through a calibrated [`Camera`](crate::geometry::Camera);
 //! - [`plot`]: line plots;
+//! - [`animated_png`]: animations a browser plays (APNG);
 //! - [`shadow`]: the area of a mesh's shadow on the ground (a drape coefficient's measure).
 
+pub mod animated_png;
 pub mod picture;
 pub mod plot;
 pub mod raster;

@@ -258,7 +258,7 @@ pub fn broadcast_frame(
     out
 }
 
-/// Writes [`broadcast_frame`] as a PNG to `path`.
+/// Writes [`broadcast_frame`] as a PNG to `path` and returns it.
 ///
 /// # Errors
 ///
@@ -270,7 +270,7 @@ pub fn write_overlay_png(
     cameras: &[Camera],
     tracked: &[Vec3; JOINT_COUNT],
     truth: Option<&[Vec3; JOINT_COUNT]>,
-) -> Result<(), TrackingOutputError> {
+) -> Result<RgbImage, TrackingOutputError> {
     let pic = broadcast_frame(images, cameras, tracked, truth);
     if pic.width() == 0 || pic.height() == 0 {
         return Err(TrackingOutputError::InvalidInput(
@@ -281,7 +281,8 @@ pub fn write_overlay_png(
         .map_err(|e| TrackingOutputError::Image {
             path: path.to_path_buf(),
             message: e.to_string(),
-        })
+        })?;
+    Ok(pic)
 }
 
 /// Reads pixel `(x, y)` as `[r, g, b]`, `None` outside the image (for checks and tests).

@@ -1,5 +1,6 @@
 //! Everything a tracking run writes: the tracked motion (BVH and joint CSV), the broadcast
-//! overlay pictures (every camera with the skeleton drawn, the ground truth too when known),
+//! overlay pictures (every camera with the skeleton drawn, the ground truth too when known)
+//! and their slow-motion animation (`broadcast.png`, an animated PNG a browser plays),
 //! the swing metrics (CSV and plots), per-frame errors against the ground truth, and a
 //! JSON summary with the time per stage.
 
@@ -13,6 +14,12 @@ use super::overlay::write_overlay_png;
 use super::sequence_files::{Sequence, SequenceError};
 use super::swing_metrics::{swing_metrics, write_swing_metrics};
 use super::tracker::TrackResult;
+use crate::render::animated_png::{AnimatedPng, AnimatedPngError};
+
+/// How many times slower than life the broadcast animation plays.
+pub const SLOW_MOTION: f64 = 5.0;
+/// Largest width of the broadcast animation's frames (pixels).
+const ANIMATION_WIDTH: u32 = 640;
 
 /// What to write.
 #[derive(Clone, Debug)]
@@ -36,6 +43,9 @@ pub enum TrackOutputError {
     /// Reading the sequence's images failed.
     #[error(transparent)]
     Sequence(#[from] SequenceError),
+    /// The broadcast animation could not be written.
+    #[error(transparent)]
+    Animation(#[from] AnimatedPngError),
     /// A folder or file could not be written.
     #[error("{}: {source}", path.display())]
     Io {
@@ -135,13 +145,46 @@ pub fn write_track_outputs(
     if options.overlay_every > 0 {
         let dir = out.join("overlay");
         std::fs::create_dir_all(&dir).map_err(io(&dir))?;
-        for k in (0..result.joints.len()).step_by(options.overlay_every) {
+        let picked: Vec<usize> = (0..result.joints.len())
+            .step_by(options.overlay_every)
+            .collect();
+        let mut movie: Option<AnimatedPng> = None;
+        for &k in &picked {
             let f = result.first_frame + k;
             let images = seq.frame_images(f)?;
             let truth = seq.ground_truth.as_ref().and_then(|g| g.get(f));
             let path = dir.join(format!("{f:04}.png"));
-            write_overlay_png(&path, &images, &seq.cameras, &result.joints[k], truth)?;
+            let pic = write_overlay_png(&path, &images, &seq.cameras, &result.joints[k], truth)?;
             files.push(path);
+            let pic = if pic.width() > ANIMATION_WIDTH {
+                let h = (pic.height() as u64 * ANIMATION_WIDTH as u64 / pic.width() as u64).max(1);
+                image::imageops::resize(
+                    &pic,
+                    ANIMATION_WIDTH,
+                    h as u32,
+                    image::imageops::FilterType::Triangle,
+                )
+            } else {
+                pic
+            };
+            if movie.is_none() {
+                let fps = (seq.fps / (SLOW_MOTION * options.overlay_every as f64)).max(0.1);
+                let path = out.join("broadcast.png");
+                let n = picked.len() as u32;
+                movie = Some(AnimatedPng::create(
+                    &path,
+                    pic.width(),
+                    pic.height(),
+                    n,
+                    fps,
+                )?);
+            }
+            if let Some(m) = movie.as_mut() {
+                m.add(&pic)?;
+            }
+        }
+        if let Some(m) = movie {
+            files.push(m.finish()?);
         }
     }
     let path = out.join("summary.json");
