@@ -5,11 +5,12 @@
 //! through the downswing and hide his painted clothes, and `scripts/golf_track.rhai` runs end
 //! to end.
 
-use emilion::body::read_c3d;
+use emilion::body::{read_c3d, Animation, Mannequin, Motion, RetargetOptions};
 use emilion::geometry::files::data_dir;
 use emilion::geometry::Vec3;
 use emilion::tracking::club::{fit_club, GEARS_CLUB};
 use emilion::tracking::golf_sequence::{make_golf_sequence, GolfSequenceOptions};
+use emilion::tracking::joints::JointSet;
 use emilion::tracking::sequence::SequenceOptions;
 use emilion::tracking::sequence_dressing::DressingOptions;
 use emilion::tracking::sequence_files::Sequence;
@@ -148,6 +149,53 @@ fn every_broadcast_camera_sees_the_golfer_where_the_truth_projects() {
             );
         }
     }
+}
+
+#[test]
+fn a_bvh_clip_is_filmed_the_same_way_with_the_clips_own_joints_and_no_club() {
+    let bvh = data_dir().join("motion/cmu_bvh/002_01.bvh");
+    let mh = data_dir().join("bodies/makehuman");
+    if !bvh.is_file() || !mh.is_dir() {
+        eprintln!("skipped: {} or {} is absent", bvh.display(), mh.display());
+        return;
+    }
+    let dir = out("golf_sequence_bvh");
+    let mut o = quick(SequenceOptions {
+        frames: Some(5),
+        start_time: 0.5,
+        width: 160,
+        height: 120,
+        cameras: 1,
+        ..GolfSequenceOptions::default().sequence
+    });
+    o.reshape = 0.0;
+    o.fit_every = 1;
+    let s = make_golf_sequence(&bvh, &dir, &o).unwrap();
+    assert!(s.fit_residual_rms < 1e-3, "{} m", s.fit_residual_rms);
+    assert!(!dir.join("club.csv").exists());
+    assert!(s.truth.clubhead_peak().is_nan());
+    // the ground truth is the retargeted clip's joints on the mannequin (reshape 0)
+    let mannequin = Mannequin::load_makehuman(&mh).unwrap();
+    let joints = JointSet::new(&mannequin).unwrap();
+    let anim = Animation::new(
+        mannequin,
+        Motion::load_bvh(&bvh).unwrap(),
+        RetargetOptions::default(),
+    )
+    .unwrap();
+    let seq = Sequence::open(&dir).unwrap();
+    let truth = seq.ground_truth.as_ref().unwrap();
+    let mut pose = anim.mannequin().rest_pose();
+    let mut worst: f64 = 0.0;
+    for (k, frame) in truth.iter().enumerate() {
+        anim.pose_at_into(0.5 + k as f64 / 50.0, &mut pose);
+        let want = joints.positions(&pose);
+        for (a, b) in frame.iter().zip(&want) {
+            worst = worst.max((a - b).norm());
+        }
+    }
+    eprintln!("worst joint {} mm", worst * 1e3);
+    assert!(worst < 2e-3, "worst joint {} mm", worst * 1e3);
 }
 
 /// Pixels of camera 0's frame 0 that differ from the clean plate by more than the noise.

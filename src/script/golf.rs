@@ -246,7 +246,8 @@ grip_rms_mm, peak_frame, files}.",
         engine,
         "track::golf_sequence",
         ["c3d: String", "out: String", "options: Map", "Map"],
-        "Makes a synthetic broadcast sequence of a GEARS golf swing (C3D) into folder `out`, in
+        "Makes a synthetic broadcast sequence of a GEARS golf swing (C3D; or of any BVH clip, without
+a club: `c3d` ending in `.bvh`) into folder `out`, in
 the layout `track::make_sequence` writes (so `track_body.rhai` tracks it): the puppet fitted
 to the markers, every segment length and the girth changed by a seeded factor within
 ±`reshape` (default 0.1), in clothes-like colours, holding the club fitted to its markers;

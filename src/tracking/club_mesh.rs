@@ -40,6 +40,15 @@ impl Default for ClubMesh {
 }
 
 impl ClubMesh {
+    /// No club: no vertex, no triangle (a golfer filmed without one).
+    pub fn empty() -> ClubMesh {
+        ClubMesh {
+            positions: Vec::new(),
+            colours: Vec::new(),
+            triangles: Vec::new(),
+        }
+    }
+
     /// The club's topology and colours (positions at the origin until placed).
     pub fn new() -> ClubMesh {
         let mut colours = Vec::new();

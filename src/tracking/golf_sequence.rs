@@ -9,6 +9,10 @@
 //! the mean of [`GolfSequenceOptions::blur_samples`] instants over the shutter's opening), in
 //! front of real photos, with changing light and noise ([`super::sequence_render`]).
 //!
+//! A BVH clip instead of a capture ([`super::golf_motion`]) gives the same sequence of
+//! another motion (a CMU walk, a dance), without a club: the puppet is fitted to the
+//! retargeted mannequin's joints, then reshaped and dressed the same way.
+//!
 //! The swing's parameters are fitted on every [`GolfSequenceOptions::fit_every`]-th capture
 //! frame and interpolated linearly in time between them; the club is carried in the lead
 //! hand's bone frame (its grip held at one place in the hand, the shaft turned as captured,
@@ -31,18 +35,18 @@ use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use super::clothing::{clothing_colours, shaded_colours, Palette};
-use super::club::{fit_club, ClubFit, GEARS_CLUB};
+use super::club::ClubFit;
 use super::club_mesh::ClubMesh;
 use super::golf_metrics::{golf_metrics, write_golf_metrics, GolfMetrics};
+use super::golf_motion::{club_in_hand, load_motion, reshaped, Swing};
 use super::joints::{JOINT_COUNT, TRACKING_JOINTS};
-use super::marker_fit::{fit_markers, MarkerFitOptions};
-use super::marker_set::MarkerSet;
+use super::marker_fit::MarkerFitOptions;
 use super::puppet::{Proportions, Puppet};
 use super::sequence::{SequenceOptions, SequenceSummary};
 use super::sequence_dressing::{BodyMotion, DressingOptions, Wardrobe, WardrobeReport};
 use super::sequence_files::{io_err, write_joints_csv, SequenceError};
 use super::sequence_render::{mix, SceneMesh, SequenceWriter};
-use crate::body::{read_c3d, Mannequin, Pose};
+use crate::body::{Mannequin, Pose};
 use crate::geometry::Camera;
 use crate::geometry::{SplitMix64, Vec3};
 use crate::limits;
@@ -50,6 +54,9 @@ use crate::limits;
 /// Tracking joints of the hips (`l_hip`, `r_hip` of [`TRACKING_JOINTS`]).
 const JOINT_L_HIP: usize = 10;
 const JOINT_R_HIP: usize = 13;
+
+/// The ground truth of a frame: the joints, and the club's grip and head when held.
+type TruthFrame = ([Vec3; JOINT_COUNT], Option<(Vec3, Vec3)>);
 
 /// The broadcast cameras' roles, in camera order.
 pub const CAMERA_ROLES: [&str; 4] = ["face-on", "down-the-line", "behind", "high"];
@@ -156,108 +163,6 @@ pub struct GolfSequenceSummary {
     pub dressing: Option<WardrobeReport>,
 }
 
-/// `p` with each field multiplied by a factor drawn uniformly in `[1 − r, 1 + r]` from `rng`.
-fn reshaped(p: Proportions, r: f64, rng: &mut SplitMix64) -> Proportions {
-    let mut f = || 1.0 + rng.range(-r, r);
-    Proportions {
-        torso: p.torso * f(),
-        neck: p.neck * f(),
-        head: p.head * f(),
-        upper_arm: p.upper_arm * f(),
-        forearm: p.forearm * f(),
-        hand: p.hand * f(),
-        thigh: p.thigh * f(),
-        shin: p.shin * f(),
-        foot: p.foot * f(),
-        girth: p.girth * f(),
-    }
-}
-
-/// The swing as a function of time: the fitted parameters and the club in the lead hand's
-/// rest frame, sampled at `rate`, interpolated linearly.
-#[derive(Clone)]
-struct Swing {
-    rate: f64,
-    params: Vec<Vec<f64>>,
-    /// Grip and head in the golfer's lead-hand rest frame, per fitted frame.
-    club: Vec<(Vec3, Vec3)>,
-    hand: usize,
-}
-
-impl Swing {
-    /// Parameters, grip and head (golfer's rest frame of the hand) at time `t`.
-    fn at(&self, t: f64, params: &mut Vec<f64>) -> (Vec3, Vec3) {
-        let n = self.params.len();
-        let x = (t * self.rate).clamp(0.0, (n - 1) as f64);
-        let i = (x.floor() as usize).min(n - 1);
-        let j = (i + 1).min(n - 1);
-        let w = x - i as f64;
-        params.clear();
-        params.extend(
-            self.params[i]
-                .iter()
-                .zip(&self.params[j])
-                .map(|(a, b)| a + (b - a) * w),
-        );
-        let (a, b) = (self.club[i], self.club[j]);
-        (a.0 + (b.0 - a.0) * w, a.1 + (b.1 - a.1) * w)
-    }
-}
-
-/// Club points per fitted frame in the fitted hand's rest frame, moved to the golfer's hand
-/// (`shift`); frames without a club fit take the nearest frame's. The grip is then held at
-/// its mean place in the hand (the capture's wrist marker slides on the club by a few
-/// centimetres, which would show the club beside the hands), the shaft keeping each frame's
-/// direction and length. Fails when no frame has a club fit.
-fn club_in_hand(
-    fit_puppet: &Puppet,
-    params: &[Vec<f64>],
-    club: &ClubFit,
-    hand: usize,
-    shift: Vec3,
-) -> Result<Vec<(Vec3, Vec3)>, String> {
-    let mut pose = Pose::identity(fit_puppet.bone_count());
-    let local: Vec<Option<(Vec3, Vec3)>> = params
-        .iter()
-        .enumerate()
-        .map(|(f, p)| {
-            let (g, h) = (club.grip.get(f).copied()??, club.head.get(f).copied()??);
-            fit_puppet.pose_into(p, &mut pose);
-            let inv = pose.transform(hand).inverse();
-            let to_rest = |x: Vec3| (inv * nalgebra::Point3::from(x)).coords + shift;
-            Some((to_rest(g), to_rest(h)))
-        })
-        .collect();
-    let seen: Vec<usize> = (0..local.len()).filter(|&f| local[f].is_some()).collect();
-    if seen.is_empty() {
-        return Err("no frame sees three club markers".into());
-    }
-    let filled: Vec<(Vec3, Vec3)> = (0..local.len())
-        .map(|f| {
-            let k = seen.partition_point(|&s| s < f);
-            let near = match (k.checked_sub(1).map(|i| seen[i]), seen.get(k)) {
-                (Some(a), Some(&b)) => {
-                    if f - a <= b - f {
-                        a
-                    } else {
-                        b
-                    }
-                }
-                (Some(a), None) => a,
-                (None, Some(&b)) => b,
-                (None, None) => unreachable!("seen is not empty"),
-            };
-            local[f].unwrap_or_else(|| local[near].expect("a seen frame"))
-        })
-        .collect();
-    // the grip held fixed in the hand (its mean place), the shaft turned as captured
-    let grip = filled.iter().map(|x| x.0).sum::<Vec3>() / filled.len() as f64;
-    Ok(filled
-        .into_iter()
-        .map(|(g, h)| (grip, grip + (h - g)))
-        .collect())
-}
-
 /// The broadcast cameras around a golfer whose pelvis stands at `pelvis`, facing `forward`
 /// (horizontal unit vector, toward the ball) with the target along `target` (horizontal unit
 /// vector): face-on, down the line (behind the trail side, looking at the target), from
@@ -307,8 +212,9 @@ pub fn broadcast_cameras(
         .collect()
 }
 
-/// Makes a broadcast sequence of the golf swing in `c3d` (a GEARS capture) into `out`
-/// (created; existing files are overwritten): see the [module docs](self).
+/// Makes a broadcast sequence of the golf swing in `c3d` (a GEARS capture, `.c3d`) or of
+/// any motion clip (`.bvh`, no club) into `out` (created; existing files are overwritten):
+/// see the [module docs](self).
 pub fn make_golf_sequence(
     c3d: &Path,
     out: &Path,
@@ -322,16 +228,10 @@ pub fn make_golf_sequence(
         message: m,
     };
     let mannequin = Mannequin::load_makehuman(&o.makehuman)?;
-    let mut trial = read_c3d(c3d)?;
-    trial.up = trial.infer_up();
-    let sub = trial.every(options.fit_every);
-    let fit = fit_markers(&mannequin, &sub, &MarkerSet::gears(), &options.fit)
-        .map_err(|m| motion_err(format!("marker fit: {m}")))?;
-    let (a, b, wrist) = GEARS_CLUB;
-    let club = fit_club(&sub, &a, &b, wrist).map_err(motion_err)?;
+    let source = load_motion(&mannequin, c3d, options.fit_every, &options.fit)?;
     let mut rng = SplitMix64::new(mix(o.seed, 6, 0));
-    let proportions = reshaped(fit.puppet.proportions(), options.reshape, &mut rng);
-    let golfer = fit
+    let proportions = reshaped(source.puppet.proportions(), options.reshape, &mut rng);
+    let golfer = source
         .puppet
         .with_proportions(&proportions)
         .map_err(motion_err)?;
@@ -339,11 +239,17 @@ pub fn make_golf_sequence(
         .skeleton()
         .bone_index("wrist.L")
         .ok_or_else(|| motion_err("the mannequin has no bone wrist.L".into()))?;
-    let shift = golfer.rest_heads()[hand] - fit.puppet.rest_heads()[hand];
+    let shift = golfer.rest_heads()[hand] - source.puppet.rest_heads()[hand];
+    let club = match &source.club {
+        Some(c) => {
+            Some(club_in_hand(&source.puppet, &source.params, c, hand, shift).map_err(motion_err)?)
+        }
+        None => None,
+    };
     let swing = Swing {
-        rate: sub.rate,
-        club: club_in_hand(&fit.puppet, &fit.params, &club, hand, shift).map_err(motion_err)?,
-        params: fit.params.clone(),
+        rate: source.rate,
+        club,
+        params: source.params.clone(),
         hand,
     };
     let colours = clothing_colours(&mannequin, o.seed);
@@ -356,7 +262,7 @@ pub fn make_golf_sequence(
     let frames = match o.frames {
         Some(f) => f,
         None => {
-            let n = ((trial.duration() - o.start_time).max(0.0) * o.fps + 1e-9).floor() + 1.0;
+            let n = ((source.duration - o.start_time).max(0.0) * o.fps + 1e-9).floor() + 1.0;
             let what = format!("the frame count of {}", c3d.display());
             limits::check(&what, n, "max_frames", limits::get().max_frames)
                 .map_err(|e| SequenceError::Options(e.to_string()))? as usize
@@ -369,16 +275,16 @@ pub fn make_golf_sequence(
     let mut params = Vec::new();
     let mut club_mesh = ClubMesh::new();
     let mut at = |t: f64, skin: Option<&mut Vec<Vec3>>| {
-        let (g, h) = swing.at(o.start_time + t, &mut params);
+        let club = swing.at(o.start_time + t, &mut params);
         golfer.pose_into(&params, &mut pose);
         if let Some(skin) = skin {
             golfer.skin(&pose, skin);
         }
         let joints = golfer.joints(&pose);
-        (joints, pose.apply(swing.hand, g), pose.apply(swing.hand, h))
+        let club = club.map(|(g, h)| (pose.apply(swing.hand, g), pose.apply(swing.hand, h)));
+        (joints, club)
     };
-    let truth: Vec<([Vec3; JOINT_COUNT], Vec3, Vec3)> =
-        (0..frames).map(|k| at(time(k), None)).collect();
+    let truth: Vec<TruthFrame> = (0..frames).map(|k| at(time(k), None)).collect();
 
     // cameras from the address position, framing the whole swing
     let first = truth[0].0;
@@ -388,27 +294,24 @@ pub fn make_golf_sequence(
         .try_normalize(1e-9)
         .unwrap_or_else(Vec3::x);
     let forward = target.cross(&Vec3::z());
-    let points: Vec<Vec3> = truth
-        .iter()
-        .flat_map(|(j, _, _)| j.iter().copied())
-        .collect();
+    let points: Vec<Vec3> = truth.iter().flat_map(|(j, _)| j.iter().copied()).collect();
     let cameras = broadcast_cameras(
         o.cameras, o.width, o.height, first[0], forward, target, &points,
     )?;
     let mut writer = SequenceWriter::new(out, cameras, &points, o)?;
     writer.write_cameras_and_plates()?;
     write_ground_truth(out, &truth, &time, o.seed)?;
-    let truth_club = ClubFit {
+    let truth_club = source.club.as_ref().map(|club| ClubFit {
         rate: o.fps,
         head_markers: Vec::new(),
         shaft_markers: Vec::new(),
-        head: truth.iter().map(|x| Some(x.2)).collect(),
-        grip: truth.iter().map(|x| Some(x.1)).collect(),
+        head: truth.iter().map(|x| x.1.map(|c| c.1)).collect(),
+        grip: truth.iter().map(|x| x.1.map(|c| c.0)).collect(),
         length: club.length,
         grip_rms: club.grip_rms,
-    };
+    });
     let joints: Vec<[Vec3; JOINT_COUNT]> = truth.iter().map(|x| x.0).collect();
-    let metrics = golf_metrics(&joints, o.fps, Some(&truth_club));
+    let metrics = golf_metrics(&joints, o.fps, truth_club.as_ref());
     write_golf_metrics(out, "truth_metrics", &metrics)
         .map_err(|e| SequenceError::Options(e.to_string()))?;
 
@@ -424,6 +327,9 @@ pub fn make_golf_sequence(
         .iter()
         .map(|t| t.map(|i| i as u32))
         .collect();
+    if swing.club.is_none() {
+        club_mesh = ClubMesh::empty();
+    }
     let offset = colours.len() as u32;
     let cloth_offset = offset + club_mesh.positions.len() as u32;
     let cloth_triangles = wardrobe
@@ -454,8 +360,9 @@ pub fn make_golf_sequence(
                 0.0
             };
             let t = time(k) + phase * options.shutter;
-            let (_, g, h) = at(t, Some(&mut skin));
-            club_mesh.place(g, h);
+            if let (_, Some((g, h))) = at(t, Some(&mut skin)) {
+                club_mesh.place(g, h);
+            }
             scene.positions.clear();
             scene.positions.extend_from_slice(&skin);
             scene.positions.extend_from_slice(&club_mesh.positions);
@@ -501,8 +408,8 @@ pub fn make_golf_sequence(
             "blur_samples": options.blur_samples,
             "reshape": options.reshape,
             "fit_every": options.fit_every,
-            "fit_residual_rms_mm": fit.rms() * 1e3,
-            "club_length": club.length,
+            "fit_residual_rms_mm": source.residual_rms * 1e3,
+            "club_length": source.club.as_ref().map(|c| c.length),
             "proportions": proportions.to_json(),
             "dressing": wardrobe.as_ref().map(|w| &w.report),
         },
@@ -525,7 +432,7 @@ pub fn make_golf_sequence(
             seconds_per_frame: seconds / frames as f64,
         },
         proportions,
-        fit_residual_rms: fit.rms(),
+        fit_residual_rms: source.residual_rms,
         truth: metrics,
         dressing: wardrobe.map(|w| w.report),
     })
@@ -572,10 +479,10 @@ fn dress_golfer(
 }
 
 /// `ground_truth.csv`, `init_joints.csv` (frame 0 with 2 cm of seeded noise, as
-/// [`super::sequence`] writes it) and `club.csv`.
+/// [`super::sequence`] writes it) and, with a club, `club.csv`.
 fn write_ground_truth(
     out: &Path,
-    truth: &[([Vec3; JOINT_COUNT], Vec3, Vec3)],
+    truth: &[TruthFrame],
     time: &dyn Fn(usize) -> f64,
     seed: u64,
 ) -> Result<(), SequenceError> {
@@ -590,8 +497,12 @@ fn write_ground_truth(
         .0
         .map(|p| p + Vec3::new(rng.normal(), rng.normal(), rng.normal()) * 0.02);
     write_joints_csv(&out.join("init_joints.csv"), &[(0, 0.0, init)])?;
+    if truth.iter().any(|x| x.1.is_none()) {
+        return Ok(());
+    }
     let mut csv = String::from("frame,time,grip_x,grip_y,grip_z,head_x,head_y,head_z\n");
-    for (k, (_, g, h)) in truth.iter().enumerate() {
+    for (k, (_, c)) in truth.iter().enumerate() {
+        let Some((g, h)) = c else { continue };
         csv += &format!(
             "{k},{},{},{},{},{},{},{}\n",
             time(k),

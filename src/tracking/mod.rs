@@ -34,6 +34,7 @@ pub mod cost;
 pub mod dlt;
 pub mod frame_status;
 pub mod golf_metrics;
+pub mod golf_motion;
 pub mod golf_sequence;
 pub mod golf_track;
 pub mod golf_trial;
