@@ -43,6 +43,7 @@ const QUICK: &[(&str, &[&str])] = &[
             "width=160",
             "height=120",
             "cameras=1",
+            "edge=0.04",
         ],
     ),
     ("golf_track", &["frames=2", "adapt_body=false"]),
