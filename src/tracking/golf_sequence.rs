@@ -44,7 +44,7 @@ use super::marker_fit::MarkerFitOptions;
 use super::puppet::{Proportions, Puppet};
 use super::sequence::{SequenceOptions, SequenceSummary};
 use super::sequence_dressing::{BodyMotion, DressingOptions, Wardrobe, WardrobeReport};
-use super::sequence_files::{io_err, write_joints_csv, SequenceError};
+use super::sequence_files::{io_err, write_sequence_json, write_truth_files, SequenceError};
 use super::sequence_render::{mix, SceneMesh, SequenceWriter};
 use crate::body::{Mannequin, Pose};
 use crate::geometry::Camera;
@@ -414,12 +414,7 @@ pub fn make_golf_sequence(
             "dressing": wardrobe.as_ref().map(|w| &w.report),
         },
     });
-    let meta_path = out.join("sequence.json");
-    let text = serde_json::to_string_pretty(&meta).map_err(|e| SequenceError::Json {
-        path: meta_path.clone(),
-        message: e.to_string(),
-    })?;
-    std::fs::write(&meta_path, text + "\n").map_err(io_err(&meta_path))?;
+    write_sequence_json(out, &meta)?;
     let seconds = start.elapsed().as_secs_f64();
     Ok(GolfSequenceSummary {
         sequence: SequenceSummary {
@@ -491,12 +486,7 @@ fn write_ground_truth(
         .enumerate()
         .map(|(k, x)| (k, time(k), x.0))
         .collect();
-    write_joints_csv(&out.join("ground_truth.csv"), &rows)?;
-    let mut rng = SplitMix64::new(mix(seed, 4, 0));
-    let init = truth[0]
-        .0
-        .map(|p| p + Vec3::new(rng.normal(), rng.normal(), rng.normal()) * 0.02);
-    write_joints_csv(&out.join("init_joints.csv"), &[(0, 0.0, init)])?;
+    write_truth_files(out, &rows, &mut SplitMix64::new(mix(seed, 4, 0)))?;
     if truth.iter().any(|x| x.1.is_none()) {
         return Ok(());
     }

@@ -50,7 +50,7 @@ use serde::Serialize;
 
 use super::clothing::{clothing_colours, dominant_bone, shaded_colours, skin_positions};
 use super::joints::{JointSet, TRACKING_JOINTS};
-use super::sequence_files::{io_err, write_joints_csv, JointFrame, SequenceError};
+use super::sequence_files::{write_sequence_json, write_truth_files, JointFrame, SequenceError};
 pub use super::sequence_options::SequenceOptions;
 pub use super::sequence_render::Occluder;
 use super::sequence_render::{mix, SceneMesh, SequenceWriter};
@@ -196,21 +196,13 @@ pub fn make_sequence(
         "seed": o.seed,
         "camera_details": writer.camera_details,
     });
-    let meta_path = out.join("sequence.json");
-    let text = serde_json::to_string_pretty(&meta).map_err(|e| SequenceError::Json {
-        path: meta_path.clone(),
-        message: e.to_string(),
-    })?;
-    std::fs::write(&meta_path, text + "\n").map_err(io_err(&meta_path))?;
+    write_sequence_json(out, &meta)?;
     let rows: Vec<_> = truth
         .iter()
         .enumerate()
         .map(|(k, j)| (k, time(k), *j))
         .collect();
-    write_joints_csv(&out.join("ground_truth.csv"), &rows)?;
-    let mut rng = SplitMix64::new(mix(o.seed, 4, 0));
-    let init = truth[0].map(|p| p + Vec3::new(rng.normal(), rng.normal(), rng.normal()) * 0.02);
-    write_joints_csv(&out.join("init_joints.csv"), &[(0, 0.0, init)])?;
+    write_truth_files(out, &rows, &mut SplitMix64::new(mix(o.seed, 4, 0)))?;
 
     // the frames: cameras rendered in parallel
     let pb = if std::io::stderr().is_terminal() {

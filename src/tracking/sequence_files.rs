@@ -139,6 +139,31 @@ pub enum SequenceError {
     Options(String),
 }
 
+/// Writes `DIR/sequence.json` (pretty JSON and a newline).
+pub(crate) fn write_sequence_json(out: &Path, meta: &Value) -> Result<(), SequenceError> {
+    let path = out.join("sequence.json");
+    let text = serde_json::to_string_pretty(meta).map_err(|e| SequenceError::Json {
+        path: path.clone(),
+        message: e.to_string(),
+    })?;
+    std::fs::write(&path, text + "\n").map_err(io_err(&path))
+}
+
+/// Writes `DIR/ground_truth.csv` (`rows`: frame, time, joints) and `DIR/init_joints.csv`
+/// (the first row's joints with 2 cm of Gaussian noise per coordinate drawn from `rng`).
+pub(crate) fn write_truth_files(
+    out: &Path,
+    rows: &[(usize, f64, JointFrame)],
+    rng: &mut SplitMix64,
+) -> Result<(), SequenceError> {
+    write_joints_csv(&out.join("ground_truth.csv"), rows)?;
+    if let Some((_, _, first)) = rows.first() {
+        let init = first.map(|p| p + Vec3::new(rng.normal(), rng.normal(), rng.normal()) * 0.02);
+        write_joints_csv(&out.join("init_joints.csv"), &[(0, 0.0, init)])?;
+    }
+    Ok(())
+}
+
 /// An `Io` error for `path`.
 pub(crate) fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> SequenceError + '_ {
     move |source| SequenceError::Io {
