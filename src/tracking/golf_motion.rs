@@ -1,9 +1,9 @@
 //! The motion of a golf broadcast sequence, as the puppet's parameters over time
-//! ([`load_motion`]): a GEARS capture (C3D: the puppet fitted to the body markers, the club
+//! (`load_motion`): a GEARS capture (C3D: the puppet fitted to the body markers, the club
 //! to its markers, [`super::marker_fit`], [`super::club`]) or any BVH clip (the mannequin
 //! driven by the retargeted clip, the puppet fitted to its sixteen tracking joints frame by
 //! frame, [`Puppet::fit_to_joints`]; no club). The sequence maker then reshapes the puppet
-//! ([`reshaped`]) and plays the parameters ([`Swing`]).
+//! (`reshaped`) and plays the parameters (`Swing`).
 
 use std::path::Path;
 

@@ -1,6 +1,6 @@
 //! Real garments on the person of a synthetic sequence ([`Wardrobe`]): each garment table
 //! (FreeSewing patterns, `scripts/patterns/*.garment.json`) is meshed, pre-positioned, sewn
-//! and draped on the person at rest with [`crate::garment::dress`] in a measured fabric; the
+//! and draped on the person at rest with [`crate::garment::dress()`] in a measured fabric; the
 //! body then moves from its rest pose into the motion's pose at [`BodyMotion::start`] and
 //! plays the motion, and each garment is simulated through it (body contact and
 //! self-collision on), so the cloth folds, slides and hides the body as clothes do.
