@@ -463,17 +463,19 @@ impl Wardrobe {
     /// the worst count, the smallest and the largest distance in the report.
     pub fn check(&mut self) {
         let mut inside = 0;
-        for l in &mut self.layers {
-            let x = l.sim.state.x.clone();
-            let r = l.sim.contact_mut().report(&x);
-            inside += r.penetrating;
+        for l in &self.layers {
             let body = &l.sim.contact().bodies[0];
-            let far = x
+            for q in l
+                .sim
+                .state
+                .x
                 .iter()
                 .filter_map(|p| body.proximity(p, f64::INFINITY))
-                .fold(0.0f64, |m, q| m.max(q.distance));
-            self.report.max_distance = self.report.max_distance.max(far);
-            self.report.min_distance = self.report.min_distance.min(r.min_distance);
+            {
+                inside += usize::from(q.distance < 0.0);
+                self.report.min_distance = self.report.min_distance.min(q.distance);
+                self.report.max_distance = self.report.max_distance.max(q.distance);
+            }
         }
         self.report.worst_penetrating = self.report.worst_penetrating.max(inside);
         self.report.penetrating.push(inside);
