@@ -8,6 +8,7 @@ use super::tracking_sequence::{apply_options, number, whole};
 use super::{function, modules::ApiBuilder};
 use crate::body::Mannequin;
 use crate::geometry::files::data_path;
+use crate::tracking::club_track::{track_club_in, ClubTrackOptions};
 use crate::tracking::golf_sequence::{make_golf_sequence, GolfSequenceOptions};
 use crate::tracking::golf_track::golf_report;
 use crate::tracking::golf_trial::run_golf_trial;
@@ -190,6 +191,34 @@ fn golf_sequence(c3d: &str, out: &str, m: &Map) -> RResult<Map> {
     Ok(map)
 }
 
+fn golf_club_map(seq: &str, tracked: &str, m: &Map) -> RResult<Map> {
+    let seq = Sequence::open(read_folder(seq)?).map_err(rt_err)?;
+    let mut o = ClubTrackOptions::default();
+    let get = |k: &str| m.get(k).map(|d| number(d, k)).transpose();
+    if let Some(v) = get("directions")? {
+        o.directions = v.clamp(10.0, 1e6) as usize;
+    }
+    if let Some(v) = get("samples")? {
+        o.samples = v.clamp(4.0, 1e4) as usize;
+    }
+    if let Some(v) = get("ridge_px")? {
+        o.ridge_px = v.clamp(0.5, 50.0);
+    }
+    if let Some(v) = get("threshold")? {
+        o.threshold = v.clamp(0.0, 1.0);
+    }
+    let c = track_club_in(&seq, &read_folder(tracked)?, &o).map_err(rt_err)?;
+    let mut map = Map::new();
+    let fl = |x: f64| Dynamic::from_float(x);
+    let n = c.grip.len().max(1) as f64;
+    map.insert("frames".into(), Dynamic::from_int(c.grip.len() as INT));
+    map.insert("length_m".into(), fl(c.length));
+    map.insert("seconds".into(), fl(c.seconds));
+    map.insert("s_per_frame".into(), fl(c.seconds / n));
+    map.insert("mean_score".into(), fl(c.scores.iter().sum::<f64>() / n));
+    Ok(map)
+}
+
 fn golf_report_map(seq: &str, tracked: &str) -> RResult<Map> {
     let seq = Sequence::open(read_folder(seq)?).map_err(rt_err)?;
     let r = golf_report(&seq, &read_folder(tracked)?).map_err(rt_err)?;
@@ -218,6 +247,11 @@ fn golf_report_map(seq: &str, tracked: &str) -> RResult<Map> {
         "truth_clubhead_peak_mps".into(),
         fl(r.truth.clubhead_peak()),
     );
+    map.insert(
+        "tracked_clubhead_peak_mps".into(),
+        fl(r.tracked.clubhead_peak()),
+    );
+    map.insert("clubhead_error_mm".into(), fl(1e3 * r.head_error));
     map.insert("files".into(), Dynamic::from_int(r.files.len() as INT));
     Ok(map)
 }
@@ -273,16 +307,33 @@ xfactor_peak_deg, proportions}.",
     );
     function!(
         engine,
+        "track::golf_club",
+        ["seq: String", "tracked: String", "options: Map", "Map"],
+        "Tracks the golf club in the golf sequence `seq` after the body (`tracked/tracked_joints.csv`,
+written by `track::body`): in every frame the straight shaft from the hands whose projections
+run along thin foreground lines in all cameras (the grip started at the tracked lead wrist;
+every direction tried; the length searched over the first frames). Writes
+`tracked/tracked_club.csv` (grip and head per frame, the layout of the sequence's
+`club.csv`), which `track::golf_report` then compares with the truth. Options: `directions`
+(tried over the sphere, default 3000), `samples` (points along the shaft per camera, 48),
+`ridge_px` (side distance of the line test, 3), `threshold` (evidence a point must carry,
+0.08). Returns #{frames, length_m, seconds, s_per_frame, mean_score}.",
+        |seq: &str, tracked: &str, m: Map| golf_club_map(seq, tracked, &m)
+    );
+    function!(
+        engine,
         "track::golf_report",
         ["seq: String", "tracked: String", "Map"],
         "Compares the tracked joints in `tracked/tracked_joints.csv` (written by `track::body`)
 with the ground truth of the golf sequence `seq` (its `ground_truth.csv` and `club.csv`) on
 the frames tracked, and writes under `tracked`: `truth_metrics.csv`, `tracked_metrics.csv`
 (with their rotation and speed plots) and `golf_compare_speed`, `golf_compare_xfactor` (PNG,
-SVG). The club is not tracked: `clubhead_speed_err_pct` is NaN. Returns
-#{wrist_speed_err_pct, xfactor_err_deg, clubhead_speed_err_pct, truth_lead_wrist_peak_mps,
-tracked_lead_wrist_peak_mps, truth_xfactor_peak_deg, tracked_xfactor_peak_deg,
-truth_clubhead_peak_mps, files}.",
+SVG). The tracked club is read from `tracked/tracked_club.csv` (`track::golf_club`); without
+it `clubhead_speed_err_pct` is NaN. Returns #{wrist_speed_err_pct, xfactor_err_deg,
+clubhead_speed_err_pct, truth_lead_wrist_peak_mps, tracked_lead_wrist_peak_mps,
+truth_xfactor_peak_deg, tracked_xfactor_peak_deg, truth_clubhead_peak_mps,
+tracked_clubhead_peak_mps, clubhead_error_mm (mean distance of the tracked head from the
+truth's), files}.",
         |seq: &str, tracked: &str| golf_report_map(seq, tracked)
     );
 }

@@ -3,7 +3,8 @@
 //! [`super::golf_sequence`]), as the errors the acceptance names (peak lead-wrist
 //! speed, peak X-factor, peak club-head speed) and plots of both curves.
 //!
-//! The club is not tracked yet: the tracked club-head speed is NaN, and so is its error.
+//! The tracked club is read from `tracked_club.csv` beside the tracked joints (written by
+//! [`super::club_track`]); without it the tracked club-head speed is NaN, and so is its error.
 
 use std::path::{Path, PathBuf};
 
@@ -20,8 +21,11 @@ use crate::render::plot::{write_plot_pair, PlotSpec, SeriesStyle};
 pub struct GolfReport {
     /// Metrics of the ground truth (with the club).
     pub truth: GolfMetrics,
-    /// Metrics of the tracked joints (no club).
+    /// Metrics of the tracked joints (and of the tracked club when there is one).
     pub tracked: GolfMetrics,
+    /// Mean distance of the tracked club head from the truth's, metres (NaN without a
+    /// tracked club or without the truth's).
+    pub head_error: f64,
     /// Files written.
     pub files: Vec<PathBuf>,
 }
@@ -35,7 +39,7 @@ impl GolfReport {
     pub fn xfactor_err_deg(&self) -> f64 {
         (self.tracked.x_factor_peak() - self.truth.x_factor_peak()).abs()
     }
-    /// Error of the tracked peak club-head speed, percent (NaN: the club is not tracked).
+    /// Error of the tracked peak club-head speed, percent (NaN when the club is not tracked).
     pub fn clubhead_speed_err_pct(&self) -> f64 {
         pct(self.tracked.clubhead_peak(), self.truth.clubhead_peak())
     }
@@ -113,8 +117,22 @@ pub fn golf_report(seq: &Sequence, tracked_dir: &Path) -> Result<GolfReport, Tra
         c.grip = c.grip.into_iter().skip(first).take(n).collect();
         c
     });
+    let tracked_club = read_club(&tracked_dir.join("tracked_club.csv"), seq.fps)?.map(|mut c| {
+        c.head.truncate(n);
+        c.grip.truncate(n);
+        c
+    });
+    let head_error = match (&club, &tracked_club) {
+        (Some(t), Some(c)) => {
+            let d: Vec<f64> = (t.head.iter().zip(&c.head))
+                .filter_map(|(a, b)| Some((a.as_ref()? - b.as_ref()?).norm()))
+                .collect();
+            d.iter().sum::<f64>() / d.len() as f64
+        }
+        _ => f64::NAN,
+    };
     let mut truth_m = golf_metrics(&truth, seq.fps, club.as_ref());
-    let mut tracked_m = golf_metrics(&tracked[..n], seq.fps, None);
+    let mut tracked_m = golf_metrics(&tracked[..n], seq.fps, tracked_club.as_ref());
     let t0 = first as f64 / seq.fps;
     for m in [&mut truth_m, &mut tracked_m] {
         m.swing.time.iter_mut().for_each(|t| *t += t0);
@@ -126,8 +144,8 @@ pub fn golf_report(seq: &Sequence, tracked_dir: &Path) -> Result<GolfReport, Tra
         &tracked_m,
     )?);
     let t = &truth_m.swing.time;
-    let speed = PlotSpec {
-        title: "Lead wrist speed: ground truth and tracking".to_string(),
+    let mut speed = PlotSpec {
+        title: "Lead wrist and club-head speed: ground truth and tracking".to_string(),
         x_label: "time (s)".to_string(),
         y_label: "speed (m/s)".to_string(),
         series: vec![
@@ -140,6 +158,22 @@ pub fn golf_report(seq: &Sequence, tracked_dir: &Path) -> Result<GolfReport, Tra
             ),
         ],
     };
+    if tracked_club.is_some() {
+        speed.series.extend([
+            series(
+                "club head, truth",
+                t,
+                &truth_m.clubhead_speed,
+                SeriesStyle::Markers,
+            ),
+            series(
+                "club head, tracked",
+                t,
+                &tracked_m.clubhead_speed,
+                SeriesStyle::Dashed,
+            ),
+        ]);
+    }
     let (a, b) = write_plot_pair(&tracked_dir.join("golf_compare_speed"), &speed)?;
     let xf = PlotSpec {
         title: "X-factor: ground truth and tracking".to_string(),
@@ -165,6 +199,7 @@ pub fn golf_report(seq: &Sequence, tracked_dir: &Path) -> Result<GolfReport, Tra
     Ok(GolfReport {
         truth: truth_m,
         tracked: tracked_m,
+        head_error,
         files,
     })
 }
