@@ -8,9 +8,9 @@ use super::tracking_sequence::{apply_options, number, whole};
 use super::{function, modules::ApiBuilder};
 use crate::body::Mannequin;
 use crate::geometry::files::data_path;
-use crate::tracking::club_track::{track_club_in, ClubTrackOptions};
+use crate::tracking::club_track::ClubTrackOptions;
 use crate::tracking::golf_sequence::{make_golf_sequence, GolfSequenceOptions};
-use crate::tracking::golf_track::golf_report;
+use crate::tracking::golf_track::{golf_report, track_club_in};
 use crate::tracking::golf_trial::run_golf_trial;
 use crate::tracking::marker_fit::MarkerFitOptions;
 use crate::tracking::sequence_dressing::DressingOptions;
@@ -314,7 +314,9 @@ written by `track::body`): in every frame the straight shaft from the hands whos
 run along thin foreground lines in all cameras (the grip started at the tracked lead wrist;
 every direction tried; the length searched over the first frames). Writes
 `tracked/tracked_club.csv` (grip and head per frame, the layout of the sequence's
-`club.csv`), which `track::golf_report` then compares with the truth. Options: `directions`
+`club.csv`), which `track::golf_report` then compares with the truth, and draws the club
+and its head's path into the broadcast pictures under `tracked/overlay/` and
+`tracked/broadcast.png`. Options: `directions`
 (tried over the sphere, default 3000), `samples` (points along the shaft per camera, 48),
 `ridge_px` (side distance of the line test, 3), `threshold` (evidence a point must carry,
 0.08). Returns #{frames, length_m, seconds, s_per_frame, mean_score}.",

@@ -39,7 +39,7 @@ use super::club_path::{smoothest_path, MotionWeights, Shaft};
 use super::cost::{FrameViews, Robust};
 use super::joints::{joint_index, JOINT_COUNT};
 use super::pyramid::Level;
-use super::sequence_files::{read_joints_csv, Sequence};
+use super::sequence_files::Sequence;
 use super::tracker::{sequence_backgrounds, TrackError};
 use crate::geometry::Vec3;
 
@@ -298,23 +298,6 @@ pub fn track_club(
     out.length += HEAD_RADIUS;
     out.seconds = t0.elapsed().as_secs_f64();
     Ok(out)
-}
-
-/// [`track_club`] on the body tracked into `tracked_dir` (its `tracked_joints.csv`, the
-/// frames from the sequence's frame of its first row); writes `tracked_club.csv` there.
-pub fn track_club_in(
-    seq: &Sequence,
-    tracked_dir: &Path,
-    options: &ClubTrackOptions,
-) -> Result<TrackedClub, TrackError> {
-    let path = tracked_dir.join("tracked_joints.csv");
-    let rows = read_joints_csv(&path)?;
-    let first = (rows.first().map_or(0.0, |r| r.1) * seq.fps).round() as usize;
-    let joints: Vec<[Vec3; JOINT_COUNT]> = rows.iter().map(|r| r.2).collect();
-    let club = track_club(seq, &joints, first, options)?;
-    club.write_csv(&tracked_dir.join("tracked_club.csv"))
-        .map_err(|e| TrackError::Invalid(e.to_string()))?;
-    Ok(club)
 }
 
 /// The shutter time of a golf sequence's cameras, from its `sequence.json` (`golf.shutter`).

@@ -4,15 +4,20 @@
 //! speed, peak X-factor, peak club-head speed) and plots of both curves.
 //!
 //! The tracked club is read from `tracked_club.csv` beside the tracked joints (written by
-//! [`super::club_track`]); without it the tracked club-head speed is NaN, and so is its error.
+//! [`super::club_track`], on a tracked folder by [`track_club_in`], which also draws the club
+//! into its broadcast pictures); without it the tracked club-head speed is NaN, and so is its
+//! error.
 
 use std::path::{Path, PathBuf};
 
 use super::bvh_export::{io_error, TrackingOutputError};
 use super::club::ClubFit;
+use super::club_track::{track_club, ClubTrackOptions, TrackedClub};
 use super::golf_metrics::{golf_metrics, series, write_golf_metrics, GolfMetrics};
 use super::joints::JOINT_COUNT;
 use super::sequence_files::{read_joints_csv, Sequence};
+use super::track_outputs::{write_broadcast, ClubOverlay};
+use super::tracker::TrackError;
 use crate::geometry::Vec3;
 use crate::render::plot::{write_plot_pair, PlotSpec, SeriesStyle};
 
@@ -47,6 +52,43 @@ impl GolfReport {
 
 fn pct(x: f64, truth: f64) -> f64 {
     100.0 * (x - truth).abs() / truth.abs()
+}
+
+/// Tracks the club ([`super::club_track`]) of the golf sequence `seq` on the body tracked into
+/// `tracked_dir` (its `tracked_joints.csv`, the frames from the sequence's frame of its first
+/// row); writes `tracked_club.csv` there and draws the club into the broadcast pictures
+/// found under `overlay/` (and `broadcast.png`).
+pub fn track_club_in(
+    seq: &Sequence,
+    tracked_dir: &Path,
+    options: &ClubTrackOptions,
+) -> Result<TrackedClub, TrackError> {
+    let path = tracked_dir.join("tracked_joints.csv");
+    let rows = read_joints_csv(&path)?;
+    let first = (rows.first().map_or(0.0, |r| r.1) * seq.fps).round() as usize;
+    let joints: Vec<[Vec3; JOINT_COUNT]> = rows.iter().map(|r| r.2).collect();
+    let club = track_club(seq, &joints, first, options)?;
+    club.write_csv(&tracked_dir.join("tracked_club.csv"))
+        .map_err(|e| TrackError::Invalid(e.to_string()))?;
+    // the broadcast pictures the body's run wrote, drawn again with the club
+    let overlays: Vec<usize> = std::fs::read_dir(tracked_dir.join("overlay"))
+        .map(|d| {
+            let mut v: Vec<usize> = (d.flatten())
+                .filter_map(|e| e.file_name().to_str()?.strip_suffix(".png")?.parse().ok())
+                .collect();
+            v.sort_unstable();
+            v
+        })
+        .unwrap_or_default();
+    if !overlays.is_empty() {
+        let overlay = ClubOverlay {
+            grip: &club.grip,
+            head: &club.head,
+        };
+        write_broadcast(seq, tracked_dir, first, &joints, &overlays, Some(overlay))
+            .map_err(|e| TrackError::Invalid(e.to_string()))?;
+    }
+    Ok(club)
 }
 
 /// Reads `club.csv` (`frame,time,grip_x,grip_y,grip_z,head_x,head_y,head_z`) of a golf

@@ -236,6 +236,18 @@ pub fn broadcast_frame(
     tracked: &[Vec3; JOINT_COUNT],
     truth: Option<&[Vec3; JOINT_COUNT]>,
 ) -> RgbImage {
+    broadcast_frame_with(images, cameras, tracked, truth, |_, _| {})
+}
+
+/// [`broadcast_frame`] with more drawn over each camera's tile after the skeletons:
+/// `extra(tile, camera)` (the club, for one).
+pub fn broadcast_frame_with(
+    images: &[RgbImage],
+    cameras: &[Camera],
+    tracked: &[Vec3; JOINT_COUNT],
+    truth: Option<&[Vec3; JOINT_COUNT]>,
+    extra: impl Fn(&mut RgbImage, &Camera),
+) -> RgbImage {
     let (cols, rows) = grid_size(images.len());
     let cw = images.iter().map(|i| i.width()).max().unwrap_or(0);
     let ch = images.iter().map(|i| i.height()).max().unwrap_or(0);
@@ -251,6 +263,7 @@ pub fn broadcast_frame(
                 draw_skeleton_styled(&mut tile, cam, t, &SkeletonStyle::truth());
             }
             draw_skeleton_styled(&mut tile, cam, tracked, &SkeletonStyle::tracked());
+            extra(&mut tile, cam);
         }
         let (ox, oy) = ((i % cols) as i64 * cw as i64, (i / cols) as i64 * ch as i64);
         image::imageops::replace(&mut out, &tile, ox, oy);
@@ -271,7 +284,19 @@ pub fn write_overlay_png(
     tracked: &[Vec3; JOINT_COUNT],
     truth: Option<&[Vec3; JOINT_COUNT]>,
 ) -> Result<RgbImage, TrackingOutputError> {
-    let pic = broadcast_frame(images, cameras, tracked, truth);
+    write_overlay_png_with(path, images, cameras, tracked, truth, |_, _| {})
+}
+
+/// [`write_overlay_png`] of [`broadcast_frame_with`].
+pub fn write_overlay_png_with(
+    path: &Path,
+    images: &[RgbImage],
+    cameras: &[Camera],
+    tracked: &[Vec3; JOINT_COUNT],
+    truth: Option<&[Vec3; JOINT_COUNT]>,
+    extra: impl Fn(&mut RgbImage, &Camera),
+) -> Result<RgbImage, TrackingOutputError> {
+    let pic = broadcast_frame_with(images, cameras, tracked, truth, extra);
     if pic.width() == 0 || pic.height() == 0 {
         return Err(TrackingOutputError::InvalidInput(
             "no (non-empty) camera image to draw the overlay on".to_string(),
@@ -283,6 +308,24 @@ pub fn write_overlay_png(
             message: e.to_string(),
         })?;
     Ok(pic)
+}
+
+/// Colour of the tracked club's shaft and of its head's path in the overlays.
+pub const CLUB_COLOUR: [u8; 3] = [255, 150, 20];
+
+/// Draws a club over `image` seen by `cam`: the shaft from `grip` to `head`, the head as a
+/// dot, and the head's path over the frames before (`path`, oldest first) as a thin line.
+pub fn draw_club(image: &mut RgbImage, cam: &Camera, grip: Vec3, head: Vec3, path: &[Vec3]) {
+    let project = |p: &Vec3| cam.project(p);
+    for w in path.windows(2) {
+        if let (Some(a), Some(b)) = (project(&w[0]), project(&w[1])) {
+            draw_line(image, a, b, 1.0, CLUB_COLOUR);
+        }
+    }
+    if let (Some(a), Some(b)) = (project(&grip), project(&head)) {
+        draw_line(image, a, b, 2.0, CLUB_COLOUR);
+        draw_dot(image, b, 3.0, CLUB_COLOUR);
+    }
 }
 
 /// Reads pixel `(x, y)` as `[r, g, b]`, `None` outside the image (for checks and tests).
@@ -310,5 +353,31 @@ mod tests {
         assert_eq!(img.get_pixel(10, 0).0, [0, 0, 0]);
         draw_line(&mut img, [f64::NAN, 5.0], [1.0, 5.0], 3.0, [0, 255, 0]);
         draw_line(&mut img, [-50.0, -50.0], [-40.0, -60.0], 3.0, [0, 255, 0]);
+    }
+
+    #[test]
+    fn the_club_is_drawn_where_it_projects() {
+        let cam = Camera::looking_at_up(
+            Vec3::new(0.0, -5.0, 1.0),
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::z(),
+            400.0,
+            320,
+            240,
+        );
+        let mut img = RgbImage::new(320, 240);
+        let (grip, head) = (Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.8, 0.0, 0.3));
+        let path = [Vec3::new(-0.8, 0.0, 0.3), Vec3::new(0.0, 0.0, 0.0), head];
+        draw_club(&mut img, &cam, grip, head, &path);
+        let at = |p: Vec3| {
+            let [x, y] = cam.project(&p).unwrap();
+            img.get_pixel(x.round() as u32, y.round() as u32).0
+        };
+        assert_eq!(at(head), CLUB_COLOUR);
+        assert_eq!(at(0.5 * (grip + head)), CLUB_COLOUR);
+        // the path's thin line is anti-aliased: orange, if not at full strength
+        let [r, g, b] = at(Vec3::new(-0.4, 0.0, 0.15));
+        assert!(r >= 100 && r > g && g > b, "{:?}", [r, g, b]);
+        assert_eq!(at(Vec3::new(-0.6, 0.0, 1.2)), [0, 0, 0]);
     }
 }

@@ -8,12 +8,13 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::bvh_export::{write_bvh, write_joints_csv, TrackingOutputError};
-use super::joints::{joint_index, TRACKING_JOINTS};
+use super::joints::{joint_index, JOINT_COUNT, TRACKING_JOINTS};
 use super::loss::FrameStatus;
-use super::overlay::write_overlay_png;
+use super::overlay::{draw_club, write_overlay_png_with};
 use super::sequence_files::{Sequence, SequenceError};
 use super::swing_metrics::{swing_metrics, write_swing_metrics};
 use super::tracker::TrackResult;
+use crate::geometry::Vec3;
 use crate::render::animated_png::{AnimatedPng, AnimatedPngError};
 
 /// How many times slower than life the broadcast animation plays.
@@ -143,53 +144,105 @@ pub fn write_track_outputs(
     }
     files.push(write_status_csv(out, result)?);
     if options.overlay_every > 0 {
-        let dir = out.join("overlay");
-        std::fs::create_dir_all(&dir).map_err(io(&dir))?;
-        let picked: Vec<usize> = (0..result.joints.len())
+        let frames: Vec<usize> = (0..result.joints.len())
             .step_by(options.overlay_every)
+            .map(|k| result.first_frame + k)
             .collect();
-        let mut movie: Option<AnimatedPng> = None;
-        for &k in &picked {
-            let f = result.first_frame + k;
-            let images = seq.frame_images(f)?;
-            let truth = seq.ground_truth.as_ref().and_then(|g| g.get(f));
-            let path = dir.join(format!("{f:04}.png"));
-            let pic = write_overlay_png(&path, &images, &seq.cameras, &result.joints[k], truth)?;
-            files.push(path);
-            let pic = if pic.width() > ANIMATION_WIDTH {
-                let h = (pic.height() as u64 * ANIMATION_WIDTH as u64 / pic.width() as u64).max(1);
-                image::imageops::resize(
-                    &pic,
-                    ANIMATION_WIDTH,
-                    h as u32,
-                    image::imageops::FilterType::Triangle,
-                )
-            } else {
-                pic
-            };
-            if movie.is_none() {
-                let fps = (seq.fps / (SLOW_MOTION * options.overlay_every as f64)).max(0.1);
-                let path = out.join("broadcast.png");
-                let n = picked.len() as u32;
-                movie = Some(AnimatedPng::create(
-                    &path,
-                    pic.width(),
-                    pic.height(),
-                    n,
-                    fps,
-                )?);
-            }
-            if let Some(m) = movie.as_mut() {
-                m.add(&pic)?;
-            }
-        }
-        if let Some(m) = movie {
-            files.push(m.finish()?);
-        }
+        files.extend(write_broadcast(
+            seq,
+            out,
+            result.first_frame,
+            &result.joints,
+            &frames,
+            None,
+        )?);
     }
     let path = out.join("summary.json");
     std::fs::write(&path, summary_json(seq, result)).map_err(io(&path))?;
     files.push(path);
+    Ok(files)
+}
+
+/// A tracked club to draw over the broadcast pictures: grip and head per tracked frame.
+#[derive(Clone, Copy, Debug)]
+pub struct ClubOverlay<'a> {
+    /// Grip point per tracked frame (from the first tracked frame).
+    pub grip: &'a [Vec3],
+    /// Head centre per tracked frame.
+    pub head: &'a [Vec3],
+}
+
+/// Head positions of the frames before shown as the club's path.
+const CLUB_TRAIL: usize = 12;
+
+/// Writes the broadcast pictures `out/overlay/NNNN.png` of the sequence's `frames` (every
+/// camera with the tracked skeleton `joints[f − first]`, the truth beneath when known, the
+/// club with its head's path over the last frames when given) and their slow-motion
+/// animation `out/broadcast.png` (at most 640 px wide, [`SLOW_MOTION`] times slower than
+/// life, frames evenly spaced as given). Returns the files.
+pub fn write_broadcast(
+    seq: &Sequence,
+    out: &Path,
+    first: usize,
+    joints: &[[Vec3; JOINT_COUNT]],
+    frames: &[usize],
+    club: Option<ClubOverlay>,
+) -> Result<Vec<PathBuf>, TrackOutputError> {
+    let dir = out.join("overlay");
+    std::fs::create_dir_all(&dir).map_err(io(&dir))?;
+    let mut files = Vec::new();
+    let step = match frames {
+        [a, b, ..] => b.saturating_sub(*a).max(1),
+        _ => 1,
+    };
+    let frames: Vec<usize> = (frames.iter().copied())
+        .filter(|f| f.checked_sub(first).is_some_and(|k| k < joints.len()))
+        .collect();
+    let mut movie: Option<AnimatedPng> = None;
+    for &f in &frames {
+        let k = f - first;
+        let tracked = &joints[k];
+        let images = seq.frame_images(f)?;
+        let truth = seq.ground_truth.as_ref().and_then(|g| g.get(f));
+        let path = dir.join(format!("{f:04}.png"));
+        let draw = |tile: &mut image::RgbImage, cam: &crate::geometry::Camera| {
+            if let Some(c) = club.filter(|c| k < c.grip.len().min(c.head.len())) {
+                let trail = &c.head[k.saturating_sub(CLUB_TRAIL)..=k];
+                draw_club(tile, cam, c.grip[k], c.head[k], trail);
+            }
+        };
+        let pic = write_overlay_png_with(&path, &images, &seq.cameras, tracked, truth, draw)?;
+        files.push(path);
+        let pic = if pic.width() > ANIMATION_WIDTH {
+            let h = (pic.height() as u64 * ANIMATION_WIDTH as u64 / pic.width() as u64).max(1);
+            image::imageops::resize(
+                &pic,
+                ANIMATION_WIDTH,
+                h as u32,
+                image::imageops::FilterType::Triangle,
+            )
+        } else {
+            pic
+        };
+        if movie.is_none() {
+            let fps = (seq.fps / (SLOW_MOTION * step as f64)).max(0.1);
+            let path = out.join("broadcast.png");
+            let n = frames.len() as u32;
+            movie = Some(AnimatedPng::create(
+                &path,
+                pic.width(),
+                pic.height(),
+                n,
+                fps,
+            )?);
+        }
+        if let Some(m) = movie.as_mut() {
+            m.add(&pic)?;
+        }
+    }
+    if let Some(m) = movie {
+        files.push(m.finish()?);
+    }
     Ok(files)
 }
 
