@@ -55,6 +55,17 @@ impl ClubFit {
     }
 }
 
+/// The text of a club file (`club.csv` of a golf sequence, `tracked_club.csv` of a tracked
+/// one): the header `frame,time,grip_x,grip_y,grip_z,head_x,head_y,head_z`, then one row per
+/// `(frame, time, grip, head)`, metres and seconds at full precision.
+pub fn club_csv(rows: impl IntoIterator<Item = (usize, f64, Vec3, Vec3)>) -> String {
+    let mut csv = String::from("frame,time,grip_x,grip_y,grip_z,head_x,head_y,head_z\n");
+    for (k, t, g, h) in rows {
+        csv += &format!("{k},{t},{},{},{},{},{},{}\n", g.x, g.y, g.z, h.x, h.y, h.z);
+    }
+    csv
+}
+
 /// Speed per frame from frame differences: `|x[i] − x[i−1]| · rate`, NaN for frame 0 and
 /// where either sample is missing.
 pub fn frame_speeds(points: &[Option<Vec3>], rate: f64) -> Vec<f64> {

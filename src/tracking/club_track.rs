@@ -34,6 +34,7 @@ use nalgebra::UnitQuaternion;
 use rayon::prelude::*;
 
 use super::bvh_export::{io_error, TrackingOutputError};
+use super::club::club_csv;
 use super::club_evidence::{evidence_pyramid, EvidenceLevel, LEVELS};
 use super::club_path::{smoothest_path, MotionWeights, Shaft};
 use super::cost::{FrameViews, Robust};
@@ -149,20 +150,12 @@ impl TrackedClub {
     /// Writes `frame,time,grip_x,grip_y,grip_z,head_x,head_y,head_z` (the layout of a golf
     /// sequence's `club.csv`).
     pub fn write_csv(&self, path: &Path) -> Result<(), TrackingOutputError> {
-        let mut s = String::from("frame,time,grip_x,grip_y,grip_z,head_x,head_y,head_z\n");
-        for (k, (g, h)) in self.grip.iter().zip(&self.head).enumerate() {
-            let f = self.first_frame + k;
-            s.push_str(&format!(
-                "{f},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}\n",
-                f as f64 / self.rate,
-                g.x,
-                g.y,
-                g.z,
-                h.x,
-                h.y,
-                h.z
-            ));
-        }
+        let s = club_csv(
+            (self.grip.iter().zip(&self.head).enumerate()).map(|(k, (g, h))| {
+                let f = self.first_frame + k;
+                (f, f as f64 / self.rate, *g, *h)
+            }),
+        );
         std::fs::write(path, s).map_err(|e| io_error(path, e))
     }
 }

@@ -35,7 +35,7 @@ use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use super::clothing::{clothing_colours, shaded_colours, Palette};
-use super::club::ClubFit;
+use super::club::{club_csv, ClubFit};
 use super::club_mesh::ClubMesh;
 use super::golf_metrics::{golf_metrics, write_golf_metrics, GolfMetrics};
 use super::golf_motion::{club_in_hand, load_motion, reshaped, Swing};
@@ -490,20 +490,9 @@ fn write_ground_truth(
     if truth.iter().any(|x| x.1.is_none()) {
         return Ok(());
     }
-    let mut csv = String::from("frame,time,grip_x,grip_y,grip_z,head_x,head_y,head_z\n");
-    for (k, (_, c)) in truth.iter().enumerate() {
-        let Some((g, h)) = c else { continue };
-        csv += &format!(
-            "{k},{},{},{},{},{},{},{}\n",
-            time(k),
-            g.x,
-            g.y,
-            g.z,
-            h.x,
-            h.y,
-            h.z
-        );
-    }
+    let csv = club_csv(
+        (truth.iter().enumerate()).filter_map(|(k, (_, c))| c.map(|(g, h)| (k, time(k), g, h))),
+    );
     let path = out.join("club.csv");
     std::fs::write(&path, csv).map_err(io_err(&path))
 }
