@@ -39,9 +39,8 @@ use super::club_evidence::{evidence_pyramid, EvidenceLevel, LEVELS};
 use super::club_path::{smoothest_path, MotionWeights, Shaft};
 use super::cost::{FrameViews, Robust};
 use super::joints::{joint_index, JOINT_COUNT};
-use super::pyramid::Level;
 use super::sequence_files::Sequence;
-use super::tracker::{sequence_backgrounds, TrackError};
+use super::tracker::{background_models, TrackError};
 use crate::geometry::Vec3;
 
 /// How far the club's butt stands past the grip point (the hands), metres.
@@ -200,10 +199,7 @@ pub fn track_club(
             seq.frames
         )));
     }
-    let backgrounds = match seq.background_plates()? {
-        Some(plates) => plates.iter().map(Level::from_image).collect(),
-        None => sequence_backgrounds(seq, seq.frames, options.background_frames)?,
-    };
+    let backgrounds = background_models(seq, options.background_frames)?;
     let mut views = FrameViews::new(&seq.cameras, &backgrounds, 1, Robust { sigma: 40.0 });
     let sphere = sphere_directions(options.directions);
     let shutter_frames = shutter_seconds(seq).map(|s| s * seq.fps);

@@ -8,10 +8,9 @@ use super::checkpoint::TrackCheckpoint;
 use super::cost::Robust;
 use super::joints::{mpjpe, JOINT_COUNT};
 use super::loss::{FrameStatus, LossDetector, LossSettings};
-use super::pyramid::Level;
 use super::sequence_files::Sequence;
 use super::tracker::{
-    changing_pixels, sequence_backgrounds, TrackError, TrackResult, Tracker, TrackerOptions, STAGES,
+    background_models, changing_pixels, TrackError, TrackResult, Tracker, TrackerOptions, STAGES,
 };
 use crate::body::Mannequin;
 use crate::geometry::Vec3;
@@ -71,10 +70,7 @@ pub fn track_sequence_from(
             ))
         })?)
     };
-    let backgrounds = match seq.background_plates()? {
-        Some(plates) => plates.iter().map(Level::from_image).collect(),
-        None => sequence_backgrounds(seq, seq.frames, options.background_frames)?,
-    };
+    let backgrounds = background_models(seq, options.background_frames)?;
     let mut tracker = Tracker::new(mannequin, &seq.cameras, &backgrounds, options.clone())?;
     let robust = Robust {
         sigma: options.robust_sigma,

@@ -649,6 +649,15 @@ pub fn changing_pixels(
     Ok(masks)
 }
 
+/// The background model of each camera of `seq`: its clean plates when the sequence has them,
+/// else the per-pixel median of `count` frames spread over it ([`sequence_backgrounds`]).
+pub fn background_models(seq: &Sequence, count: usize) -> Result<Vec<Level>, TrackError> {
+    Ok(match seq.background_plates()? {
+        Some(plates) => plates.iter().map(Level::from_image).collect(),
+        None => sequence_backgrounds(seq, seq.frames, count)?,
+    })
+}
+
 /// Background model of every camera: the median of up to `count` frames spread evenly
 /// over the sequence.
 pub fn sequence_backgrounds(
