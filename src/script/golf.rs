@@ -207,6 +207,14 @@ fn golf_club_map(seq: &str, tracked: &str, m: &Map) -> RResult<Map> {
     if let Some(v) = get("threshold")? {
         o.threshold = v.clamp(0.0, 1.0);
     }
+    if let Some(v) = get("length")? {
+        if !(0.3..=2.0).contains(&v) {
+            return Err(rt_err(format!(
+                "`length` (grip to club-head centre) must be within 0.3..2 m, got {v}"
+            )));
+        }
+        o.length = Some(v);
+    }
     let c = track_club_in(&seq, &read_folder(tracked)?, &o).map_err(rt_err)?;
     let mut map = Map::new();
     let fl = |x: f64| Dynamic::from_float(x);
@@ -319,7 +327,8 @@ and its head's path into the broadcast pictures under `tracked/overlay/` and
 `tracked/broadcast.png`. Options: `directions`
 (tried over the sphere, default 3000), `samples` (points along the shaft per camera, 48),
 `ridge_px` (side distance of the line test, 3), `threshold` (evidence a point must carry,
-0.08). Returns #{frames, length_m, seconds, s_per_frame, mean_score}.",
+0.15), `length` (the club from the grip point to the head's centre, metres; default a
+driver's, 1.10). Returns #{frames, length_m, seconds, s_per_frame, mean_score}.",
         |seq: &str, tracked: &str, m: Map| golf_club_map(seq, tracked, &m)
     );
     function!(
