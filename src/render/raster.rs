@@ -31,6 +31,9 @@ const SUBPIXEL: f64 = 256.0;
 /// skipped (they can only come from points nearly in the camera plane).
 const MAX_COORD: f32 = 1.0e6;
 
+/// A box of pixels `(x0, y0, x1, y1)`, exclusive ends.
+pub type PixelBox = (usize, usize, usize, usize);
+
 /// A depth buffer and a colour buffer of one image, with the box touched since the last
 /// [`clear`](RasterTarget::clear).
 #[derive(Clone, Debug)]
@@ -79,6 +82,37 @@ impl RasterTarget {
     pub fn touched(&self) -> Option<(usize, usize, usize, usize)> {
         let (x0, y0, x1, y1) = self.touched;
         (x0 < x1 && y0 < y1).then_some(self.touched)
+    }
+
+    /// Makes this target equal to `base` (same size), copying only where they can differ:
+    /// inside `changed` when given (the caller knows this target is `base` plus draws inside
+    /// that box, e.g. the box [`draw_triangles`] returned after the last restore), else
+    /// inside both touched boxes. The touched box becomes `base`'s. Targets of another size
+    /// are left as they are (returns false).
+    pub fn restore_from(&mut self, base: &RasterTarget, changed: Option<PixelBox>) -> bool {
+        if base.width != self.width || base.height != self.height {
+            return false;
+        }
+        let boxes = |a: PixelBox, b: PixelBox| {
+            if a.0 >= a.2 || a.1 >= a.3 {
+                b
+            } else if b.0 >= b.2 || b.1 >= b.3 {
+                a
+            } else {
+                (a.0.min(b.0), a.1.min(b.1), a.2.max(b.2), a.3.max(b.3))
+            }
+        };
+        let (x0, y0, x1, y1) = changed.unwrap_or_else(|| boxes(self.touched, base.touched));
+        let (x1, y1) = (x1.min(self.width), y1.min(self.height));
+        if x0 < x1 && y0 < y1 {
+            for y in y0..y1 {
+                let row = y * self.width;
+                self.depth[row + x0..row + x1].copy_from_slice(&base.depth[row + x0..row + x1]);
+                self.rgb[row + x0..row + x1].copy_from_slice(&base.rgb[row + x0..row + x1]);
+            }
+        }
+        self.touched = base.touched;
+        true
     }
 
     /// Whether something was drawn at pixel `(x, y)` (false outside the image).
@@ -130,37 +164,44 @@ fn valid(p: &[f32; 3]) -> bool {
 /// Draws `triangles` (indices into `projected` and `colours`, which must have the same
 /// length; out-of-range indices skip the triangle) into `target`: both windings, Gouraud
 /// colours, nearest depth wins, top-left fill rule, clipped to the image. Triangles with an
-/// invalid vertex (see [`project_vertices`]) or no area are skipped.
+/// invalid vertex (see [`project_vertices`]) or no area are skipped. Returns the box
+/// `(x0, y0, x1, y1)` (exclusive ends) that this call may have changed, `None` when it drew
+/// nothing (the target's own touched box also covers what earlier draws changed).
 pub fn draw_triangles(
     target: &mut RasterTarget,
     projected: &[[f32; 3]],
     colours: &[[f32; 3]],
     triangles: &[[u32; 3]],
-) {
+) -> Option<PixelBox> {
     let n = projected.len().min(colours.len());
+    let mut drawn: Option<PixelBox> = None;
     for t in triangles {
         let (i0, i1, i2) = (t[0] as usize, t[1] as usize, t[2] as usize);
         if i0 >= n || i1 >= n || i2 >= n {
             continue;
         }
-        draw_one(
+        if let Some(b) = draw_one(
             target,
             [&projected[i0], &projected[i1], &projected[i2]],
             [&colours[i0], &colours[i1], &colours[i2]],
-        );
+        ) {
+            drawn = Some(match drawn {
+                None => b,
+                Some(d) => (d.0.min(b.0), d.1.min(b.1), d.2.max(b.2), d.3.max(b.3)),
+            });
+        }
     }
+    drawn
 }
 
 /// Draws one triangle (see [`draw_triangles`]).
 #[inline]
-fn draw_one(target: &mut RasterTarget, p: [&[f32; 3]; 3], c: [&[f32; 3]; 3]) {
+fn draw_one(target: &mut RasterTarget, p: [&[f32; 3]; 3], c: [&[f32; 3]; 3]) -> Option<PixelBox> {
     if !(valid(p[0]) && valid(p[1]) && valid(p[2])) {
-        return;
+        return None;
     }
     let corners = p.map(|p| [p[0] as f64, p[1] as f64]);
-    let Some(scan) = TriangleScan::new(corners, target.width, target.height) else {
-        return;
-    };
+    let scan = TriangleScan::new(corners, target.width, target.height)?;
     let (x0, y0, x1, y1) = scan.pixel_box();
     target.touch(x0, y0, x1, y1);
     let order = scan.order();
@@ -181,6 +222,7 @@ fn draw_one(target: &mut RasterTarget, p: [&[f32; 3]; 3], c: [&[f32; 3]; 3]) {
             ];
         }
     });
+    Some((x0, y0, x1, y1))
 }
 
 /// The pixel traversal of one triangle, shared by every triangle fill of the crate (this
@@ -442,5 +484,36 @@ mod tests {
             sum += count(&one);
         }
         assert_eq!(sum, 48 * 36, "pixels drawn by more than one triangle");
+    }
+
+    #[test]
+    fn a_target_restored_from_a_base_is_the_base_again_and_the_draw_box_is_returned() {
+        let mut base = RasterTarget::new(20, 10);
+        let tri = [[1.0, 1.0, 2.0], [8.0, 1.0, 2.0], [1.0, 8.0, 2.0]];
+        assert_eq!(
+            draw_triangles(&mut base, &tri, &[[9.0; 3]; 3], &[[0, 1, 2]]),
+            Some((1, 1, 9, 9))
+        );
+        // a target that drew something else elsewhere, then restored in full
+        let mut t = RasterTarget::new(20, 10);
+        let other = [[12.0, 2.0, 1.0], [18.0, 2.0, 1.0], [12.0, 9.0, 1.0]];
+        let drawn = draw_triangles(&mut t, &other, &[[5.0; 3]; 3], &[[0, 1, 2]]);
+        assert_eq!(drawn, Some((12, 2, 19, 10)));
+        assert!(t.restore_from(&base, None));
+        assert_eq!(
+            (&t.depth, &t.rgb, t.touched()),
+            (&base.depth, &base.rgb, base.touched())
+        );
+        // a draw over the restored target, restored by its box alone
+        let drawn = draw_triangles(&mut t, &other, &[[5.0; 3]; 3], &[[0, 1, 2]]);
+        assert_eq!(t.touched(), Some((1, 1, 19, 10)));
+        assert!(t.restore_from(&base, drawn));
+        assert_eq!(
+            (&t.depth, &t.rgb, t.touched()),
+            (&base.depth, &base.rgb, base.touched())
+        );
+        // nothing drawn: no box
+        assert_eq!(draw_triangles(&mut t, &other, &[[5.0; 3]; 3], &[]), None);
+        assert!(!t.restore_from(&RasterTarget::new(4, 4), None));
     }
 }

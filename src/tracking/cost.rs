@@ -23,7 +23,7 @@ use super::pyramid::{build_pyramid, lighting_gain, Level};
 use crate::body::skinning::Pose;
 use crate::geometry::Camera;
 use crate::geometry::Vec3;
-use crate::render::raster::{draw_triangles, project_vertices, RasterTarget};
+use crate::render::raster::{draw_triangles, project_vertices, PixelBox, RasterTarget};
 
 /// Without colours, what covering a pixel costs before the background term: covering a
 /// background pixel (ρ(I − B) ≈ 0) costs this much, covering a foreground pixel
@@ -79,7 +79,7 @@ pub struct FrameViews {
     pub views: Vec<Vec<ViewLevel>>,
     /// Lighting gain of the current frame per camera.
     pub gains: Vec<f32>,
-    robust: Robust,
+    pub(super) robust: Robust,
     /// Most a puppet pixel may cost (1: no cap; ρ ≤ 1). Lower values make covering the
     /// background or an occluder cheaper (tried: 0.3 and 0.1 did not help on the punch).
     pub cover_cap: f32,
@@ -215,10 +215,15 @@ pub struct CostWorkspace {
     pub pose: Pose,
     /// Skinned mesh vertices.
     pub skinned: Vec<Vec3>,
-    projected: Vec<[f32; 3]>,
-    grey: Vec<[f32; 3]>,
+    pub(super) projected: Vec<[f32; 3]>,
+    pub(super) grey: Vec<[f32; 3]>,
     /// `targets[camera][level]`.
-    targets: Vec<Vec<RasterTarget>>,
+    pub(super) targets: Vec<Vec<RasterTarget>>,
+    /// The moving part's skinned vertices ([`super::stage_cost`]).
+    pub(super) moving: Vec<Vec3>,
+    /// Per camera and level: the [`super::stage_cost::StageBase`] generation the target was
+    /// last restored from, and the box drawn since (`None`: unknown, restore everything).
+    pub(super) restored: Vec<Vec<(u64, Option<PixelBox>)>>,
 }
 
 impl CostWorkspace {
@@ -237,6 +242,12 @@ impl CostWorkspace {
                         .map(|l| RasterTarget::new(l.image_width(), l.image_height()))
                         .collect()
                 })
+                .collect(),
+            moving: Vec::with_capacity(vertices),
+            restored: views
+                .views
+                .iter()
+                .map(|v| vec![(0, None); v.len()])
                 .collect(),
         }
     }
@@ -266,6 +277,24 @@ impl ViewLevel {
     }
 }
 
+/// What covering one (active) pixel costs: `min(ρ(I − R) − ρ(I − B), cap)` with colours,
+/// `SILHOUETTE_COVER − ρ(I − B)` without (`bg` = ρ(I − B)).
+#[inline]
+pub(super) fn pixel_cost(
+    coloured: bool,
+    robust: Robust,
+    cap: f32,
+    image: &[f32; 3],
+    render: &[f32; 3],
+    bg: f32,
+) -> f32 {
+    if coloured {
+        (robust.rho_colours(image, render) - bg).min(cap)
+    } else {
+        SILHOUETTE_COVER - bg
+    }
+}
+
 /// The cost of pose `params` at pyramid `level` (lower is better). Per pixel terms are
 /// summed over cameras and scaled by `4^level / 1000`, so levels give comparable numbers.
 pub fn pose_cost(
@@ -284,6 +313,7 @@ pub fn pose_cost(
         project_vertices(&vl.camera, &ws.skinned, &mut ws.projected);
         let target = &mut ws.targets[c][level];
         target.clear();
+        ws.restored[c][level] = (0, None);
         let colours = app.colours.unwrap_or(&ws.grey);
         draw_triangles(target, &ws.projected, colours, &app.mesh.triangles);
         let Some((x0, y0, x1, y1)) = target.touched() else {
@@ -295,12 +325,14 @@ pub fn pose_cost(
             let row = y * w;
             for i in row + x0..row + x1 {
                 if target.depth[i] < f32::INFINITY && vl.active[i] {
-                    let bg = vl.bg_cost[i];
-                    sum += if app.colours.is_some() {
-                        (robust.rho_colours(&vl.image.rgb[i], &target.rgb[i]) - bg).min(cover_cap)
-                    } else {
-                        SILHOUETTE_COVER - bg
-                    };
+                    sum += pixel_cost(
+                        app.colours.is_some(),
+                        robust,
+                        cover_cap,
+                        &vl.image.rgb[i],
+                        &target.rgb[i],
+                        vl.bg_cost[i],
+                    );
                 }
             }
         }

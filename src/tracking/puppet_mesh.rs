@@ -199,6 +199,26 @@ impl TrackingMesh {
         }
     }
 
+    /// The vertices `subset` (indices, in range) skinned into `out` (cleared first), rigidly
+    /// or by linear blend skinning, each as [`skin_rigid_into`](Self::skin_rigid_into) or
+    /// [`skin_lbs_into`](Self::skin_lbs_into) would place it.
+    pub fn skin_subset_into(&self, pose: &Pose, lbs: bool, subset: &[u32], out: &mut Vec<Vec3>) {
+        out.clear();
+        out.extend(subset.iter().map(|&v| {
+            let v = v as usize;
+            let p = self.rest[v];
+            if lbs {
+                let (bs, ws) = (&self.lbs_bones[v], &self.lbs_weights[v]);
+                (0..4)
+                    .filter(|&k| ws[k] > 0.0)
+                    .map(|k| carry(pose, bs[k], p) * ws[k])
+                    .sum()
+            } else {
+                carry(pose, self.bone[v], p)
+            }
+        }));
+    }
+
     /// Linear blend skinning with the (up to four) kept influences, into `out` (the first
     /// `min(out.len(), self.len())` vertices).
     pub fn skin_lbs_into(&self, pose: &Pose, out: &mut [Vec3]) {

@@ -21,12 +21,14 @@ use image::RgbImage;
 
 use super::annealing::{anneal, AnnealScratch, AnnealSettings};
 use super::cost::{pose_cost, Appearance, CostWorkspace, FrameViews, Robust};
+use super::hands_prior::hands_apart_penalty;
 use super::joints::JOINT_COUNT;
 use super::puppet::{PartGroup, Puppet};
 use super::puppet_mesh::TrackingMesh;
 use super::pyramid::{median_background, Level};
 use super::restarts::{limb_restarts, trunk_restarts};
 use super::sequence_files::{Sequence, SequenceError};
+use super::stage_cost::{moving_bones, StageBase, MAX_MOVING_FRACTION};
 use super::texture::learn_colours;
 use crate::body::{Mannequin, Pose};
 use crate::geometry::{SplitMix64, Vec3};
@@ -92,6 +94,10 @@ pub struct TrackerOptions {
     /// ([`Puppet::keep_limbs`]) instead of carrying them with the trunk, and also starts from
     /// the pelvis turned and the chest twisted ([`trunk_restarts`]). Default false.
     pub anchor_limbs: bool,
+    /// Both hands hold one object (a golf club): the right arm's stage (searched after the
+    /// left) pays for wrists more than this many metres apart ([`super::hands_prior`]).
+    /// None (default): no such prior.
+    pub hands_apart: Option<f64>,
 }
 
 impl Default for TrackerOptions {
@@ -115,6 +121,7 @@ impl Default for TrackerOptions {
             adapt_body: false,
             torso_spread: 0.08,
             anchor_limbs: false,
+            hands_apart: None,
         }
     }
 }
@@ -254,6 +261,8 @@ pub struct Tracker {
     /// Further starting points of the limb stages (a pose library, during an automatic
     /// start or a recovery).
     pub(super) extra_seeds: Vec<Vec<f64>>,
+    /// The still part of the puppet during a stage that moves one part of it.
+    stage_base: StageBase,
 }
 
 impl Tracker {
@@ -281,6 +290,11 @@ impl Tracker {
             return Err(TrackError::Invalid(format!(
                 "tracker: torso_spread must be positive (got {})",
                 options.torso_spread
+            )));
+        }
+        if let Some(m) = options.hands_apart.filter(|m| !(m.is_finite() && *m > 0.0)) {
+            return Err(TrackError::Invalid(format!(
+                "tracker: hands_apart must be a positive distance in metres (got {m})"
             )));
         }
         if !(options.prior_weight.is_finite() && options.prior_weight >= 0.0) {
@@ -326,6 +340,7 @@ impl Tracker {
             stage_seconds: vec![0.0; STAGES.len()],
             evaluations: 0,
             extra_seeds: Vec::new(),
+            stage_base: StageBase::default(),
         })
     }
 
@@ -422,12 +437,34 @@ impl Tracker {
                 colours: self.colours.as_deref(),
                 lbs: self.options.lbs,
             };
+            // a stage that moves one part renders the rest once ([`super::stage_cost`])
+            let by_difference = s >= 1 && {
+                let moving = moving_bones(&self.puppet, &params, &dofs);
+                let mut ws = match self.workspaces[0].lock() {
+                    Ok(g) => g,
+                    Err(poisoned) => poisoned.into_inner(),
+                };
+                let fraction = self.stage_base.rebuild(
+                    &app,
+                    &self.views,
+                    &params,
+                    &moving,
+                    &settings.levels,
+                    &mut ws,
+                );
+                fraction < MAX_MOVING_FRACTION
+            };
+            let base = by_difference.then_some(&self.stage_base);
             let views = &self.views;
             let workspaces = &self.workspaces;
             let puppet = &self.puppet;
             // the trunk stage may keep the limbs still in the world
             let anchor = (s == 0 && self.options.anchor_limbs).then(|| puppet.limb_anchor(&params));
             let scratch = std::cell::RefCell::new(Pose::identity(0));
+            // the second arm searched (the right: a right-handed golfer's trail arm, the one
+            // hidden behind the lead arm) keeps its wrist on the grip when asked; the first
+            // arm follows the images alone, so it does not follow a lost second arm
+            let hands_apart = self.options.hands_apart.filter(|_| s == 3);
             let r = anneal(
                 &params,
                 &dofs,
@@ -451,7 +488,13 @@ impl Tracker {
                         .zip(&spread)
                         .map(|(&k, s)| ((p[k] - centre[k]) / s).powi(2))
                         .sum();
-                    pose_cost(&app, views, level, p, &mut ws) + prior_weight * prior
+                    let image = match base.and_then(|b| b.cost(&app, views, level, p, &mut ws)) {
+                        Some(c) => c,
+                        None => pose_cost(&app, views, level, p, &mut ws),
+                    };
+                    let hands = hands_apart
+                        .map_or(0.0, |m| hands_apart_penalty(&puppet.joints(&ws.pose), m));
+                    image + prior_weight * prior + hands
                 },
                 &mut self.scratch,
             );
