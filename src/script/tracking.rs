@@ -82,6 +82,7 @@ fn options(m: &Map) -> RResult<(TrackerOptions, TrackOutputOptions, Option<Strin
             "torso_spread" => o.torso_spread = finite(v, "torso_spread")?,
             "anchor_limbs" => o.anchor_limbs = flag(v, "anchor_limbs")?,
             "hands_apart" => o.hands_apart = Some(finite(v, "hands_apart")?),
+            "golf_address" => o.golf_address = flag(v, "golf_address")?,
             "frames" => o.frames = Some(count(v, "frames")?),
             "overlay_every" => out.overlay_every = count(v, "overlay_every")?,
             "makehuman" => makehuman = Some(v.to_string()),
@@ -90,7 +91,7 @@ fn options(m: &Map) -> RResult<(TrackerOptions, TrackOutputOptions, Option<Strin
                 "track_body: unknown option `{other}` (particles, layers, passes, robust_sigma, \
                      mesh_cell, lbs, background_frames, prediction, prior_weight, limb_restarts, seed, \
                      init, recover, first_frame, frames, adapt_body, torso_spread, anchor_limbs, \
-                     hands_apart, overlay_every, makehuman)"
+                     hands_apart, golf_address, overlay_every, makehuman)"
             )))
             }
         }
@@ -231,7 +232,8 @@ the pose from the first frame's images alone), `first_frame` (start there; needs
 default false), `torso_spread` (move spread of the pelvis and chest rotations, radians,
 default 0.08), `anchor_limbs` (the trunk stage keeps the upper arms and thighs still in
 the world; default false), `hands_apart` (metres: both hands hold one club, the arm
-stages pay for wrists farther apart; default none), `passes` (spread factor of each pass of the stage hierarchy per frame, e.g. [1.0, 0.35]),
+stages pay for wrists farther apart; default none), `golf_address` (the automatic start
+searches from a golfer's address pose; default false), `passes` (spread factor of each pass of the stage hierarchy per frame, e.g. [1.0, 0.35]),
 `overlay_every` (0: no pictures), `makehuman` (folder of the body model).",
         |seq: &str, out: &str, m: Map| track(seq, out, &m)
     );

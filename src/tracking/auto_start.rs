@@ -10,6 +10,7 @@
 
 use nalgebra::{UnitQuaternion, Vector3};
 
+use super::address_pose::golf_address_pose;
 use super::cost::{pose_cost, Appearance};
 use super::puppet::Puppet;
 use super::tracker::{TrackError, Tracker};
@@ -237,13 +238,18 @@ impl Tracker {
         Ok(best)
     }
 
-    /// The automatic start on `images` (the first frame): the pose search without colours
+    /// The automatic start on `images` (the first frame): the pose search (from the rest
+    /// pose, or a golfer's address with [`TrackerOptions::golf_address`](super::tracker::TrackerOptions::golf_address)) without colours
     /// (a silhouette fit), then the start's refinement (colours learnt, pose searched with
     /// them, in turn). `init_joints.csv` plays no part.
     pub fn start_auto(&mut self, images: &[image::RgbImage]) -> Result<Vec<f64>, TrackError> {
         self.set_frame(images)?;
         self.colours = None;
-        let (pose, _) = self.auto_pose(None)?;
+        let stance = self
+            .options
+            .golf_address
+            .then(|| golf_address_pose(self.puppet()));
+        let (pose, _) = self.auto_pose(stance.as_deref())?;
         Ok(self.refine_start(pose))
     }
 }

@@ -20,6 +20,7 @@
 //!   puppet's proportions fitted to the person at the start;
 //! - [`bvh_export`], [`overlay`], [`swing_metrics`], [`track_outputs`]: its outputs.
 
+pub mod address_pose;
 pub mod annealing;
 pub mod auto_start;
 pub mod body_adapt;

@@ -98,6 +98,9 @@ pub struct TrackerOptions {
     /// left) pays for wrists more than this many metres apart ([`super::hands_prior`]).
     /// None (default): no such prior.
     pub hands_apart: Option<f64>,
+    /// The automatic start searches from a golfer's address pose
+    /// ([`super::address_pose`]) instead of the rest pose. Default false.
+    pub golf_address: bool,
 }
 
 impl Default for TrackerOptions {
@@ -122,6 +125,7 @@ impl Default for TrackerOptions {
             torso_spread: 0.08,
             anchor_limbs: false,
             hands_apart: None,
+            golf_address: false,
         }
     }
 }
