@@ -3,7 +3,8 @@
 //! ([`super::visual_hull`]), the puppet is stood at its centre with its feet on its lowest
 //! point, turned to each of [`HEADINGS`] headings and raised or lowered (an occluder over
 //! the legs in two cameras carves the feet off the hull), and the best-fitting headings are
-//! refined by the tracker's own annealing from coarse to fine, every limb stage also
+//! refined (at the height the silhouettes chose and, where that differs, with the feet on
+//! the hull's lowest point) by the tracker's own annealing from coarse to fine, every limb stage also
 //! starting from a small library of limb poses ([`limb_library`]). The same search, seeded
 //! by the last good pose and scored with the learnt colours, finds the body again after a
 //! loss ([`super::loss`]).
@@ -215,8 +216,15 @@ impl Tracker {
                 let d = (turn - t).rem_euclid(std::f64::consts::TAU);
                 d.min(std::f64::consts::TAU - d) >= 60f64.to_radians() - 1e-9
             };
-            if picked.len() < REFINED && turns.iter().all(apart) {
+            if turns.len() < REFINED && turns.iter().all(apart) {
                 picked.push(p.clone());
+                // the rest pose's silhouette may prefer the puppet sunk into the floor (its
+                // spread arms then cover the clothed body); the feet on the hull's lowest
+                // point are refined too, and the refined fits decide
+                let floor = self.placed(&base, *turn, &found);
+                if (floor[2] - p[2]).abs() > 0.07 {
+                    picked.push(floor);
+                }
                 turns.push(*turn);
             }
         }
