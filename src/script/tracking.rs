@@ -83,6 +83,9 @@ fn options(m: &Map) -> RResult<(TrackerOptions, TrackOutputOptions, Option<Strin
             "anchor_limbs" => o.anchor_limbs = flag(v, "anchor_limbs")?,
             "hands_apart" => o.hands_apart = Some(finite(v, "hands_apart")?),
             "golf_address" => o.golf_address = flag(v, "golf_address")?,
+            "lead_elbow_min" => {
+                o.lead_elbow_min = Some(finite(v, "lead_elbow_min")?.to_radians())
+            }
             "frames" => o.frames = Some(count(v, "frames")?),
             "overlay_every" => out.overlay_every = count(v, "overlay_every")?,
             "makehuman" => makehuman = Some(v.to_string()),
@@ -91,7 +94,7 @@ fn options(m: &Map) -> RResult<(TrackerOptions, TrackOutputOptions, Option<Strin
                 "track_body: unknown option `{other}` (particles, layers, passes, robust_sigma, \
                      mesh_cell, lbs, background_frames, prediction, prior_weight, limb_restarts, seed, \
                      init, recover, first_frame, frames, adapt_body, torso_spread, anchor_limbs, \
-                     hands_apart, golf_address, overlay_every, makehuman)"
+                     hands_apart, golf_address, lead_elbow_min, overlay_every, makehuman)"
             )))
             }
         }
@@ -233,7 +236,9 @@ default false), `torso_spread` (move spread of the pelvis and chest rotations, r
 default 0.08), `anchor_limbs` (the trunk stage keeps the upper arms and thighs still in
 the world; default false), `hands_apart` (metres: both hands hold one club, the arm
 stages pay for wrists farther apart; default none), `golf_address` (the automatic start
-searches from a golfer's address pose; default false), `passes` (spread factor of each pass of the stage hierarchy per frame, e.g. [1.0, 0.35]),
+searches from a golfer's address pose; default false), `lead_elbow_min` (degrees: the left
+arm's stage pays for a left elbow bent below it, a golfer's straight lead arm; default
+none), `passes` (spread factor of each pass of the stage hierarchy per frame, e.g. [1.0, 0.35]),
 `overlay_every` (0: no pictures), `makehuman` (folder of the body model).",
         |seq: &str, out: &str, m: Map| track(seq, out, &m)
     );

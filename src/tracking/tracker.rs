@@ -21,7 +21,7 @@ use image::RgbImage;
 
 use super::annealing::{anneal, AnnealScratch, AnnealSettings};
 use super::cost::{pose_cost, Appearance, CostWorkspace, FrameViews, Robust};
-use super::hands_prior::hands_apart_penalty;
+use super::hands_prior::{hands_apart_penalty, lead_elbow_penalty};
 use super::joints::JOINT_COUNT;
 use super::puppet::{PartGroup, Puppet};
 use super::puppet_mesh::TrackingMesh;
@@ -98,6 +98,9 @@ pub struct TrackerOptions {
     /// left) pays for wrists more than this many metres apart ([`super::hands_prior`]).
     /// None (default): no such prior.
     pub hands_apart: Option<f64>,
+    /// A golfer's straight lead arm: the left arm's stage pays for a left elbow angle below
+    /// this (radians, π = straight; [`super::hands_prior`]). None (default): no such prior.
+    pub lead_elbow_min: Option<f64>,
     /// The automatic start searches from a golfer's address pose
     /// ([`super::address_pose`]) instead of the rest pose. Default false.
     pub golf_address: bool,
@@ -125,6 +128,7 @@ impl Default for TrackerOptions {
             torso_spread: 0.08,
             anchor_limbs: false,
             hands_apart: None,
+            lead_elbow_min: None,
             golf_address: false,
         }
     }
@@ -294,6 +298,14 @@ impl Tracker {
             return Err(TrackError::Invalid(format!(
                 "tracker: torso_spread must be positive (got {})",
                 options.torso_spread
+            )));
+        }
+        if let Some(m) = options
+            .lead_elbow_min
+            .filter(|m| !(m.is_finite() && (0.0..=std::f64::consts::PI).contains(m)))
+        {
+            return Err(TrackError::Invalid(format!(
+                "tracker: lead_elbow_min must be an angle within 0..π radians (got {m})"
             )));
         }
         if let Some(m) = options.hands_apart.filter(|m| !(m.is_finite() && *m > 0.0)) {
@@ -469,6 +481,8 @@ impl Tracker {
             // hidden behind the lead arm) keeps its wrist on the grip when asked; the first
             // arm follows the images alone, so it does not follow a lost second arm
             let hands_apart = self.options.hands_apart.filter(|_| s == 3);
+            // and the left arm's stage keeps a golfer's lead arm from folding
+            let lead_elbow = self.options.lead_elbow_min.filter(|_| s == 2);
             let r = anneal(
                 &params,
                 &dofs,
@@ -496,8 +510,13 @@ impl Tracker {
                         Some(c) => c,
                         None => pose_cost(&app, views, level, p, &mut ws),
                     };
-                    let hands = hands_apart
-                        .map_or(0.0, |m| hands_apart_penalty(&puppet.joints(&ws.pose), m));
+                    let hands = if hands_apart.is_some() || lead_elbow.is_some() {
+                        let j = puppet.joints(&ws.pose);
+                        hands_apart.map_or(0.0, |m| hands_apart_penalty(&j, m))
+                            + lead_elbow.map_or(0.0, |m| lead_elbow_penalty(&j, m))
+                    } else {
+                        0.0
+                    };
                     image + prior_weight * prior + hands
                 },
                 &mut self.scratch,
