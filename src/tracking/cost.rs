@@ -320,7 +320,7 @@ pub fn pose_cost(
             continue;
         };
         let w = target.width;
-        let mut sum = 0.0f32;
+        let mut sum = 0.0f64;
         for y in y0..y1 {
             let row = y * w;
             for i in row + x0..row + x1 {
@@ -332,11 +332,11 @@ pub fn pose_cost(
                         &vl.image.rgb[i],
                         &target.rgb[i],
                         vl.bg_cost[i],
-                    );
+                    ) as f64;
                 }
             }
         }
-        total += sum as f64;
+        total += sum;
     }
     total * (1u64 << (2 * level)) as f64 / 1000.0
 }

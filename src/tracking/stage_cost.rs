@@ -256,7 +256,7 @@ impl StageBase {
                                 &target.rgb[i],
                                 vl.bg_cost[i],
                             );
-                            delta += (pc - base.cost[i]) as f64;
+                            delta += pc as f64 - base.cost[i] as f64;
                         }
                     }
                 }
