@@ -14,13 +14,13 @@ use std::path::Path;
 
 use emilion::body::retarget::{Animation, RetargetOptions};
 use emilion::body::{Mannequin, Motion};
+use emilion::tracking::background_model::sequence_backgrounds;
 use emilion::tracking::cost::{pose_cost, Appearance, CostWorkspace, FrameViews, Robust};
 use emilion::tracking::joints::mpjpe;
 use emilion::tracking::puppet::Puppet;
 use emilion::tracking::puppet_mesh::TrackingMesh;
 use emilion::tracking::sequence_files::Sequence;
 use emilion::tracking::texture::learn_colours;
-use emilion::tracking::tracker::sequence_backgrounds;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();

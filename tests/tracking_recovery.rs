@@ -7,10 +7,11 @@
 use std::path::{Path, PathBuf};
 
 use emilion::script::run_file;
+use emilion::tracking::background_model::changing_pixels;
 use emilion::tracking::cost::{FrameViews, Robust};
 use emilion::tracking::pyramid::Level;
 use emilion::tracking::sequence_files::{read_joints_csv, Sequence};
-use emilion::tracking::tracker::{changing_pixels, TrackerOptions};
+use emilion::tracking::tracker::TrackerOptions;
 use emilion::tracking::visual_hull::{search_box, visual_hull, MIN_PERSON_VOLUME};
 
 fn root() -> PathBuf {

@@ -33,6 +33,7 @@ use std::time::Instant;
 use nalgebra::UnitQuaternion;
 use rayon::prelude::*;
 
+use super::background_model::background_models;
 use super::bvh_export::{io_error, TrackingOutputError};
 use super::club::club_csv;
 use super::club_evidence::{evidence_pyramid, EvidenceLevel, LEVELS};
@@ -40,7 +41,7 @@ use super::club_path::{smoothest_path, MotionWeights, Shaft};
 use super::cost::{FrameViews, Robust};
 use super::joints::{joint_index, JOINT_COUNT};
 use super::sequence_files::Sequence;
-use super::tracker::{background_models, TrackError};
+use super::tracker::TrackError;
 use crate::geometry::Vec3;
 
 /// How far the club's butt stands past the grip point (the hands), metres.

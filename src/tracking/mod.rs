@@ -23,6 +23,7 @@
 pub mod address_pose;
 pub mod annealing;
 pub mod auto_start;
+pub mod background_model;
 pub mod body_adapt;
 pub mod bvh_export;
 pub mod calibration;

@@ -4,14 +4,13 @@
 
 use std::time::Instant;
 
+use super::background_model::{background_models, changing_pixels};
 use super::checkpoint::TrackCheckpoint;
 use super::cost::Robust;
 use super::joints::{mpjpe, JOINT_COUNT};
 use super::loss::{FrameStatus, LossDetector, LossSettings};
 use super::sequence_files::Sequence;
-use super::tracker::{
-    background_models, changing_pixels, TrackError, TrackResult, Tracker, TrackerOptions, STAGES,
-};
+use super::tracker::{TrackError, TrackResult, Tracker, TrackerOptions, STAGES};
 use crate::body::Mannequin;
 use crate::geometry::Vec3;
 

@@ -25,9 +25,9 @@ use super::hands_prior::{hands_apart_penalty, lead_elbow_penalty};
 use super::joints::JOINT_COUNT;
 use super::puppet::{PartGroup, Puppet};
 use super::puppet_mesh::TrackingMesh;
-use super::pyramid::{median_background, Level};
+use super::pyramid::Level;
 use super::restarts::{limb_restarts, trunk_restarts};
-use super::sequence_files::{Sequence, SequenceError};
+use super::sequence_files::SequenceError;
 use super::stage_cost::{moving_bones, StageBase, MAX_MOVING_FRACTION};
 use super::texture::learn_colours;
 use crate::body::{Mannequin, Pose};
@@ -672,80 +672,4 @@ impl Tracker {
         self.puppet.pose_into(params, &mut ws.pose);
         self.puppet.joints(&ws.pose)
     }
-}
-
-/// Pixels of each camera where the scene changes at some time: the image differs from the
-/// background (after its lighting gain) by more than `threshold` in robust distance in at
-/// least one of up to `count` frames spread over the sequence. The others are a static
-/// occluder or background the person never crosses (see
-/// [`ViewLevel::active`](super::cost::ViewLevel::active)).
-pub fn changing_pixels(
-    seq: &Sequence,
-    backgrounds: &[Level],
-    count: usize,
-    robust: Robust,
-    threshold: f32,
-) -> Result<Vec<Vec<bool>>, TrackError> {
-    let frames = seq.frames;
-    let picks: Vec<usize> = if frames <= count.max(1) {
-        (0..frames).collect()
-    } else {
-        (0..count)
-            .map(|i| i * (frames - 1) / (count - 1).max(1))
-            .collect()
-    };
-    let mut masks: Vec<Vec<bool>> = backgrounds
-        .iter()
-        .map(|b| vec![false; b.rgb.len()])
-        .collect();
-    let mut scratch = Vec::new();
-    for &k in &picks {
-        for (c, img) in seq.frame_images(k)?.iter().enumerate() {
-            let level = Level::from_image(img);
-            let gain = super::pyramid::lighting_gain(&level, &backgrounds[c], &mut scratch)
-                .clamp(0.2, 5.0);
-            for ((m, p), b) in masks[c].iter_mut().zip(&level.rgb).zip(&backgrounds[c].rgb) {
-                let q = p.map(|v| v / gain);
-                if robust.rho_colours(&q, b) > threshold {
-                    *m = true;
-                }
-            }
-        }
-    }
-    Ok(masks)
-}
-
-/// The background model of each camera of `seq`: its clean plates when the sequence has them,
-/// else the per-pixel median of `count` frames spread over it ([`sequence_backgrounds`]).
-pub fn background_models(seq: &Sequence, count: usize) -> Result<Vec<Level>, TrackError> {
-    Ok(match seq.background_plates()? {
-        Some(plates) => plates.iter().map(Level::from_image).collect(),
-        None => sequence_backgrounds(seq, seq.frames, count)?,
-    })
-}
-
-/// Background model of every camera: the median of up to `count` frames spread evenly
-/// over the sequence.
-pub fn sequence_backgrounds(
-    seq: &Sequence,
-    frames: usize,
-    count: usize,
-) -> Result<Vec<Level>, TrackError> {
-    let picks: Vec<usize> = if frames <= count.max(1) {
-        (0..frames).collect()
-    } else {
-        (0..count)
-            .map(|i| i * (frames - 1) / (count - 1).max(1))
-            .collect()
-    };
-    let mut per_camera: Vec<Vec<RgbImage>> = vec![Vec::new(); seq.cameras.len()];
-    for &k in &picks {
-        for (c, img) in seq.frame_images(k)?.into_iter().enumerate() {
-            per_camera[c].push(img);
-        }
-    }
-    Ok(per_camera
-        .iter()
-        .map(|imgs| median_background(&imgs.iter().collect::<Vec<_>>()))
-        .collect())
 }
