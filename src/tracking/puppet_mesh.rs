@@ -54,6 +54,15 @@ fn carry(pose: &Pose, b: u32, p: Vec3) -> Vec3 {
     }
 }
 
+/// Where the weighted bones `bs` (weights `ws`, zero weights skipped) of `pose` carry `p`.
+#[inline]
+fn blend(pose: &Pose, p: Vec3, bs: &[u32; 4], ws: &[f64; 4]) -> Vec3 {
+    (0..4)
+        .filter(|&k| ws[k] > 0.0)
+        .map(|k| carry(pose, bs[k], p) * ws[k])
+        .sum()
+}
+
 impl TrackingMesh {
     /// Clusters `puppet`'s rest skin (the mannequin's skin re-proportioned; triangles from
     /// `mannequin`) on a grid of `cell` metres ([`DEFAULT_CELL`] if `cell` is not a positive
@@ -206,15 +215,10 @@ impl TrackingMesh {
         out.clear();
         out.extend(subset.iter().map(|&v| {
             let v = v as usize;
-            let p = self.rest[v];
             if lbs {
-                let (bs, ws) = (&self.lbs_bones[v], &self.lbs_weights[v]);
-                (0..4)
-                    .filter(|&k| ws[k] > 0.0)
-                    .map(|k| carry(pose, bs[k], p) * ws[k])
-                    .sum()
+                blend(pose, self.rest[v], &self.lbs_bones[v], &self.lbs_weights[v])
             } else {
-                carry(pose, self.bone[v], p)
+                carry(pose, self.bone[v], self.rest[v])
             }
         }));
     }
@@ -224,10 +228,7 @@ impl TrackingMesh {
     pub fn skin_lbs_into(&self, pose: &Pose, out: &mut [Vec3]) {
         let per_vertex = self.rest.iter().zip(&self.lbs_bones).zip(&self.lbs_weights);
         for (o, ((&p, bs), ws)) in out.iter_mut().zip(per_vertex) {
-            *o = (0..4)
-                .filter(|&k| ws[k] > 0.0)
-                .map(|k| carry(pose, bs[k], p) * ws[k])
-                .sum();
+            *o = blend(pose, p, bs, ws);
         }
     }
 }
