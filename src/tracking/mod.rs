@@ -64,4 +64,5 @@ pub mod swing_metrics;
 pub mod texture;
 pub mod track_outputs;
 pub mod tracker;
+pub mod tracker_options;
 pub mod visual_hull;

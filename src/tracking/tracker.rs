@@ -30,6 +30,7 @@ use super::restarts::{limb_restarts, trunk_restarts};
 use super::sequence_files::SequenceError;
 use super::stage_cost::{moving_bones, StageBase, MAX_MOVING_FRACTION};
 use super::texture::learn_colours;
+pub use super::tracker_options::TrackerOptions;
 use crate::body::{Mannequin, Pose};
 use crate::geometry::{SplitMix64, Vec3};
 
@@ -45,93 +46,6 @@ pub enum TrackError {
     /// A setting or input is unusable.
     #[error("{0}")]
     Invalid(String),
-}
-
-/// Tracker settings.
-#[derive(Clone, Debug)]
-pub struct TrackerOptions {
-    /// Particles per annealing layer (torso and head; the limb stages use half as many again).
-    pub particles: usize,
-    /// Pyramid level of each annealing layer of a stage (coarse first).
-    pub layers: Vec<usize>,
-    /// Robust scale σ of the colour difference (grey levels).
-    pub robust_sigma: f32,
-    /// Cell size of the light mesh (metres).
-    pub mesh_cell: f64,
-    /// Linear blend skinning instead of rigid.
-    pub lbs: bool,
-    /// Frames sampled for the background median.
-    pub background_frames: usize,
-    /// Prediction factor on the last velocity (0 = constant position).
-    pub prediction: f64,
-    /// Seed of the annealing moves.
-    pub seed: u64,
-    /// Track at most this many frames (from frame 0).
-    pub frames: Option<usize>,
-    /// Passes of the stage hierarchy per frame, as factors of the move spreads (a wide
-    /// search, then a narrower one that refines the torso with the limbs in place).
-    pub passes: Vec<f64>,
-    /// Weight of the motion prior (per squared move spread of a parameter).
-    pub prior_weight: f64,
-    /// Limb stages also start particles from the previous frame's limb pose (no
-    /// prediction), the rest pose, and the predicted limb half bent or straightened (see
-    /// [`limb_restarts`]).
-    pub limb_restarts: bool,
-    /// Start without approximate joints: find the person and their pose from the first
-    /// frame's images alone ([`super::auto_start`]); `init_joints.csv` is not read.
-    pub auto_start: bool,
-    /// Notice a lost track from the image fit and find the body again
-    /// ([`super::loss`]); off by default until measured on the dance clips.
-    pub recover: bool,
-    /// First frame tracked (the start is made there).
-    pub first_frame: usize,
-    /// Adapt the puppet's proportions to the person at the start ([`super::body_adapt`]).
-    pub adapt_body: bool,
-    /// Move spread of the pelvis and chest rotations, radians (their motion prior's scale
-    /// too). Default 0.08.
-    pub torso_spread: f64,
-    /// The trunk stage keeps the upper arms and thighs still in the world
-    /// ([`Puppet::keep_limbs`]) instead of carrying them with the trunk, and also starts from
-    /// the pelvis turned and the chest twisted ([`trunk_restarts`]). Default false.
-    pub anchor_limbs: bool,
-    /// Both hands hold one object (a golf club): the right arm's stage (searched after the
-    /// left) pays for wrists more than this many metres apart ([`super::hands_prior`]).
-    /// None (default): no such prior.
-    pub hands_apart: Option<f64>,
-    /// A golfer's straight lead arm: the left arm's stage pays for a left elbow angle below
-    /// this (radians, π = straight; [`super::hands_prior`]). None (default): no such prior.
-    pub lead_elbow_min: Option<f64>,
-    /// The automatic start searches from a golfer's address pose
-    /// ([`super::address_pose`]) instead of the rest pose. Default false.
-    pub golf_address: bool,
-}
-
-impl Default for TrackerOptions {
-    fn default() -> Self {
-        TrackerOptions {
-            particles: 32,
-            layers: vec![1, 1, 1, 0, 0],
-            robust_sigma: 40.0,
-            mesh_cell: super::puppet_mesh::DEFAULT_CELL,
-            lbs: false,
-            background_frames: 25,
-            prediction: 0.7,
-            seed: 1,
-            frames: None,
-            passes: vec![1.0, 0.35],
-            prior_weight: 0.05,
-            limb_restarts: true,
-            auto_start: false,
-            recover: false,
-            first_frame: 0,
-            adapt_body: false,
-            torso_spread: 0.08,
-            anchor_limbs: false,
-            hands_apart: None,
-            lead_elbow_min: None,
-            golf_address: false,
-        }
-    }
 }
 
 /// Tracked motion and its diagnostics.
@@ -281,44 +195,7 @@ impl Tracker {
         backgrounds: &[Level],
         options: TrackerOptions,
     ) -> Result<Tracker, TrackError> {
-        if options.particles < 2 || options.layers.is_empty() {
-            return Err(TrackError::Invalid(format!(
-                "tracker: need at least 2 particles and one layer (got {} and {})",
-                options.particles,
-                options.layers.len()
-            )));
-        }
-        let positive = |v: f64| v.is_finite() && v > 0.0;
-        if !positive(options.robust_sigma as f64) || !positive(options.mesh_cell) {
-            return Err(TrackError::Invalid(
-                "tracker: robust_sigma and mesh_cell must be positive".into(),
-            ));
-        }
-        if !(options.torso_spread.is_finite() && options.torso_spread > 0.0) {
-            return Err(TrackError::Invalid(format!(
-                "tracker: torso_spread must be positive (got {})",
-                options.torso_spread
-            )));
-        }
-        if let Some(m) = options
-            .lead_elbow_min
-            .filter(|m| !(m.is_finite() && (0.0..=std::f64::consts::PI).contains(m)))
-        {
-            return Err(TrackError::Invalid(format!(
-                "tracker: lead_elbow_min must be an angle within 0..π radians (got {m})"
-            )));
-        }
-        if let Some(m) = options.hands_apart.filter(|m| !(m.is_finite() && *m > 0.0)) {
-            return Err(TrackError::Invalid(format!(
-                "tracker: hands_apart must be a positive distance in metres (got {m})"
-            )));
-        }
-        if !(options.prior_weight.is_finite() && options.prior_weight >= 0.0) {
-            return Err(TrackError::Invalid(format!(
-                "tracker: prior_weight must be finite and not negative (got {})",
-                options.prior_weight
-            )));
-        }
+        options.validate().map_err(TrackError::Invalid)?;
         if cameras.len() != backgrounds.len() || cameras.is_empty() {
             return Err(TrackError::Invalid(format!(
                 "tracker: {} cameras but {} background images",
