@@ -129,3 +129,28 @@ impl TrackerOptions {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::TrackerOptions;
+
+    #[test]
+    fn the_defaults_pass_and_each_unusable_setting_is_named() {
+        assert_eq!(TrackerOptions::default().validate(), Ok(()));
+        let bad: [(&str, fn(&mut TrackerOptions)); 7] = [
+            ("particles", |o| o.particles = 1),
+            ("layer", |o| o.layers.clear()),
+            ("robust_sigma", |o| o.robust_sigma = f32::NAN),
+            ("torso_spread", |o| o.torso_spread = 0.0),
+            ("lead_elbow_min", |o| o.lead_elbow_min = Some(4.0)),
+            ("hands_apart", |o| o.hands_apart = Some(-0.1)),
+            ("prior_weight", |o| o.prior_weight = f64::INFINITY),
+        ];
+        for (name, spoil) in bad {
+            let mut o = TrackerOptions::default();
+            spoil(&mut o);
+            let e = o.validate().expect_err(name);
+            assert!(e.contains(name), "{name}: {e}");
+        }
+    }
+}
