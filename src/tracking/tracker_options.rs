@@ -134,10 +134,13 @@ impl TrackerOptions {
 mod tests {
     use super::TrackerOptions;
 
+    /// Makes one setting unusable.
+    type Spoil = fn(&mut TrackerOptions);
+
     #[test]
     fn the_defaults_pass_and_each_unusable_setting_is_named() {
         assert_eq!(TrackerOptions::default().validate(), Ok(()));
-        let bad: [(&str, fn(&mut TrackerOptions)); 7] = [
+        let bad: [(&str, Spoil); 7] = [
             ("particles", |o| o.particles = 1),
             ("layer", |o| o.layers.clear()),
             ("robust_sigma", |o| o.robust_sigma = f32::NAN),
