@@ -249,7 +249,8 @@ fn dressed_golfer_keeps_his_garments_on_and_outside_him_through_the_downswing() 
     // from a chest bent over the ball), at most one vertex in a thousand inside it, none
     // deeper than two contact thicknesses (where the arms press on the chest the garment is
     // pinched between two parts of the skinned body less than two thicknesses apart; a
-    // vertex 5.5 mm inside at address is not explained yet: docs/golf.md)
+    // vertex 5.5 mm inside at address was a static hold's target carried into the chest by
+    // the arm's tangential motion, now moved out: docs/cloth-solver.md)
     assert!(d.max_distance < 0.25, "{} m", d.max_distance);
     assert!(d.min_distance > -0.010, "{} m", d.min_distance);
     assert!(

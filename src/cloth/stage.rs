@@ -68,6 +68,14 @@ pub trait StepStage: Send + Sync + std::fmt::Debug + Any {
         false
     }
 
+    /// After a solve, before the new positions: loosens the constraints whose `impulse`
+    /// (momentum, from the solve's residual) works against them, by changing the `filter`;
+    /// returns whether any changed, and the step is then solved again with the new filter
+    /// (default: nothing to loosen).
+    fn loosen(&mut self, _impulse: &[Vec3], _filter: &mut Filter) -> bool {
+        false
+    }
+
     /// After the new positions: corrects them and the velocities (friction, push-out,
     /// cloth–cloth response).
     fn respond(&mut self, _end: StepEnd<'_>) {}

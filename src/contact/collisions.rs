@@ -8,99 +8,15 @@
 use std::time::Instant;
 
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 
 use super::body::{Body, FrictionCoefficients, Shape};
 use super::body_pin::BodyPin;
+pub use super::contact_settings::{ContactSettings, ContactStats};
 use super::proximity::Proximity;
 use super::self_collision::{SelfCollision, SelfCollisionReport};
 use super::ContactError;
 use crate::cloth::constraints::{Filter, ParticleFilter};
 use crate::geometry::Vec3;
-
-/// Contact settings of a cloth, SI units.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
-pub struct ContactSettings {
-    /// Distance kept between the cloth and bodies (m).
-    pub thickness: f64,
-    /// The fabric's friction, combined with each body's (mean of the coefficients); its two
-    /// coefficients appear as `mu_static` and `mu_kinetic` among the settings.
-    #[serde(flatten)]
-    pub friction: FrictionCoefficients,
-    /// Whether the cloth collides with itself.
-    pub self_collision: bool,
-    /// Distance kept between two layers of cloth (m).
-    pub self_thickness: f64,
-    /// Kinetic friction coefficient of cloth on cloth.
-    pub self_friction: f64,
-    /// Largest speed (m/s) at which a vertex found inside the thickness is pushed out.
-    pub max_push_speed: f64,
-    /// Count intersecting (edge, triangle) pairs of the cloth after every step (statistics).
-    pub count_intersections: bool,
-}
-
-impl Default for ContactSettings {
-    fn default() -> Self {
-        ContactSettings {
-            thickness: 0.005,
-            friction: FrictionCoefficients::default(),
-            self_collision: false,
-            self_thickness: 0.004,
-            self_friction: 0.3,
-            max_push_speed: 1.0,
-            count_intersections: true,
-        }
-    }
-}
-
-impl ContactSettings {
-    /// Checks every value, naming the first bad one.
-    pub fn validate(&self) -> Result<(), ContactError> {
-        let bad = |name: &str, v: f64| {
-            ContactError::Parameter(format!("contact setting `{name}` is invalid: {v}"))
-        };
-        for (name, v) in [
-            ("thickness", self.thickness),
-            ("self_thickness", self.self_thickness),
-            ("max_push_speed", self.max_push_speed),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(bad(name, v));
-            }
-        }
-        if !(self.self_friction.is_finite() && self.self_friction >= 0.0) {
-            return Err(bad("self_friction", self.self_friction));
-        }
-        self.friction.validate("fabric friction")
-    }
-}
-
-/// Contact statistics of one step.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-pub struct ContactStats {
-    /// Vertices constrained against a body during the step.
-    pub contacts: usize,
-    /// Cloth–cloth pairs closer than the self thickness at the start of the step.
-    pub self_contacts: usize,
-    /// Continuous cloth–cloth hits resolved.
-    pub ccd_hits: usize,
-    /// Impact-zone rounds needed.
-    pub zone_rounds: usize,
-    /// Free vertices the cloth–cloth response stopped as a last resort.
-    pub self_stopped: usize,
-    /// Smallest signed distance of a cloth vertex to a body at the end of the step (m;
-    /// infinite without bodies near).
-    pub min_distance: f64,
-    /// Vertices inside a body at the end of the step.
-    pub penetrating: usize,
-    /// Intersecting (edge, triangle) pairs of the cloth at the end of the step (when counted).
-    pub intersections: usize,
-    /// Time in collision detection and response (ms).
-    pub collision_ms: f64,
-    /// Time spent counting intersections for these statistics (ms, not in `collision_ms`).
-    pub stats_ms: f64,
-}
 
 /// Per-vertex body contact of the current step.
 #[derive(Debug, Clone, Copy)]
@@ -110,6 +26,10 @@ struct Slot {
     velocity: Vec3,
     /// Held fully (static friction) rather than sliding.
     stuck: bool,
+    /// The normal velocity prescribed while sliding (m/s).
+    vn: f64,
+    /// Distance to the body at the start of the step (m).
+    distance: f64,
 }
 
 const NO_BODY: u32 = u32::MAX;
@@ -207,6 +127,8 @@ impl Collisions {
                 normal: Vec3::zeros(),
                 velocity: Vec3::zeros(),
                 stuck: false,
+                vn: 0.0,
+                distance: 0.0,
             },
         );
         self.last_impulse.resize(n, 0.0);
@@ -281,7 +203,18 @@ impl Collisions {
             if stuck {
                 // static friction inside the solve: the particle moves with the surface
                 let vt_body = p.velocity - p.normal * p.normal.dot(&p.velocity);
-                let target = x[i] + (vt_body + p.normal * vn) * dt;
+                let mut target = x[i] + (vt_body + p.normal * vn) * dt;
+                // where the surface bends (an armpit, a garment pinched between arm and chest)
+                // the surface's tangential motion can carry the target into another part of
+                // the body: a held particle ends no deeper than planned
+                let planned = p.distance + vn * dt;
+                if let Some(q) =
+                    self.bodies[k as usize].proximity(&target, h + (vt_body.norm() + vn.abs()) * dt)
+                {
+                    if q.distance < planned - 0.25 * h {
+                        target += q.normal * (planned - q.distance);
+                    }
+                }
                 filter.kind[i] = ParticleFilter::Fixed { target };
                 filter.any = true;
             } else {
@@ -292,10 +225,41 @@ impl Collisions {
                 normal: p.normal,
                 velocity: p.velocity,
                 stuck,
+                vn,
+                distance: p.distance,
             };
             self.stats.contacts += 1;
         }
         self.ms = t0.elapsed().as_secs_f64() * 1e3;
+    }
+
+    /// After a solve: a particle held by static friction whose normal impulse (`impulse`,
+    /// momentum, from the solve's residual) pulls it onto the body is not held: in `filter`
+    /// it becomes free where it lies outside 0.9 times the thickness, a sliding contact (its
+    /// normal velocity still prescribed) where it is deeper, and the step is solved again.
+    /// Left to the next step, such a hold was let go only then, the neighbours that had pulled
+    /// it threw it into the body on that step, and it was caught and held again a few steps
+    /// later (the rim of a drape on Galerkin coarse levels cycled so). Returns whether any hold
+    /// was loosened.
+    pub fn release_pulling_holds(&mut self, impulse: &[Vec3], filter: &mut Filter) -> bool {
+        let h = self.settings.thickness;
+        let mut any = false;
+        for (i, s) in self.slots.iter_mut().enumerate() {
+            if s.body == NO_BODY || !s.stuck || s.normal.dot(&impulse[i]) >= 0.0 {
+                continue;
+            }
+            s.stuck = false;
+            filter.kind[i] = if s.distance >= 0.9 * h {
+                ParticleFilter::Free
+            } else {
+                ParticleFilter::Normal {
+                    normal: s.normal,
+                    velocity: s.vn,
+                }
+            };
+            any = true;
+        }
+        any
     }
 
     /// Friction coefficients of a contact with body `body` (zero while frictionless).

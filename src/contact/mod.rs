@@ -10,6 +10,7 @@ pub mod ccd;
 pub mod character;
 pub mod checkpoint;
 pub mod collisions;
+pub mod contact_settings;
 pub mod error;
 pub mod floor;
 pub mod impact_zone;

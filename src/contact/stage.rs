@@ -62,6 +62,10 @@ impl StepStage for Collisions {
         self.is_active()
     }
 
+    fn loosen(&mut self, impulse: &[Vec3], filter: &mut Filter) -> bool {
+        self.is_active() && self.release_pulling_holds(impulse, filter)
+    }
+
     fn respond(&mut self, end: StepEnd<'_>) {
         if self.is_active() {
             self.end_step(

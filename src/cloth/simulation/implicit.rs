@@ -172,7 +172,25 @@ impl Simulation {
         if !self.params.warm_start {
             self.dv.fill(Vec3::zeros());
         }
-        let res = self.solve(inp);
+        let mut res = self.solve(inp);
+        if self.stages_use_impulses() {
+            // a stage may loosen the constraints the solve's impulses work against (a static
+            // hold that pulls slides instead): the step is then solved once more
+            self.constraint_impulses();
+            let mut loosened = false;
+            for stage in &mut self.stages {
+                loosened |= stage.loosen(&self.impulse, &mut self.filter);
+            }
+            if loosened {
+                for i in 0..self.particle_count() {
+                    self.z[i] = self.filter.z(i, &self.state.x[i], &self.state.v[i], h);
+                }
+                let first = res.iterations;
+                res = self.solve(inp);
+                res.iterations += first;
+                self.constraint_impulses();
+            }
+        }
         // convergence is judged on the true residual, recomputed from the matrix
         let true_residual =
             self.pcg
@@ -194,13 +212,6 @@ impl Simulation {
         let t2 = Instant::now();
         if self.stages_use_impulses() {
             self.x_step.copy_from_slice(&self.state.x);
-            // constraint impulses: the residual A Δv − b lies in the constrained directions
-            for i in 0..self.particle_count() {
-                self.impulse[i] = match self.filter.kind[i] {
-                    ParticleFilter::Free => Vec3::zeros(),
-                    _ => self.asm.a.row_times(i, &self.dv) - self.asm.b[i],
-                };
-            }
         }
         // while sewing, no particle moves faster than the sewing allows, even on a step whose
         // solve did not converge
@@ -251,6 +262,17 @@ impl Simulation {
             solve_ms: (t2 - t1).as_secs_f64() * 1e3,
             ..Default::default()
         })
+    }
+
+    /// The constraint impulses of the last solve into `impulse`: the residual A Δv − b, which
+    /// lies in the constrained directions (zero for free particles).
+    fn constraint_impulses(&mut self) {
+        for i in 0..self.particle_count() {
+            self.impulse[i] = match self.filter.kind[i] {
+                ParticleFilter::Free => Vec3::zeros(),
+                _ => self.asm.a.row_times(i, &self.dv) - self.asm.b[i],
+            };
+        }
     }
 
     /// The preconditioned CG solve of the assembled system for `dv`, finishing with

@@ -17,26 +17,26 @@ use super::parallel::{for_each_index, SyncPtr, PAR_MIN};
 /// How the coarse levels see the contact constraints.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ContactCoarsening {
-    /// Galerkin coarse operators of the penalised, fixed-filtered fine operator (opt-in: it
-    /// cuts the drape's iterations, but `tests/contact.rs`'s cloth on a sphere then settles
-    /// worse, contacts 229–243 and 0.051 m/s against 228–233 and 0.022 m/s).
+    /// Galerkin coarse operators of the penalised, fixed-filtered fine operator (the default
+    /// since a static hold that pulls slides within its own step, issue 53).
     Galerkin,
     /// Rediscretised coarse cloths with the constraint of the fine particle under each coarse
     /// one, the transfers projecting out the constrained directions.
     Projected,
     /// Rediscretised coarse cloths with the constraint of the fine particle under each coarse
-    /// one (the default, as before issue 53).
+    /// one (the default before issue 53).
     Injected,
 }
 
 impl ContactCoarsening {
     /// The choice of `EMILION_MG_CONTACT` (`galerkin`, `projected`, `injected`), or the
-    /// default (`injected`).
+    /// default (`galerkin`).
     pub(crate) fn from_env() -> Self {
         match std::env::var("EMILION_MG_CONTACT").as_deref() {
             Ok("galerkin") => ContactCoarsening::Galerkin,
             Ok("projected") => ContactCoarsening::Projected,
-            _ => ContactCoarsening::Injected,
+            Ok("injected") => ContactCoarsening::Injected,
+            _ => ContactCoarsening::Galerkin,
         }
     }
 }
