@@ -175,7 +175,7 @@ impl Simulation {
         let mut res = self.solve(inp);
         if self.stages_use_impulses() {
             // a stage may loosen the constraints the solve's impulses work against (a static
-            // hold that pulls slides instead): the step is then solved once more
+            // hold that pulls is let go): the step is then solved once more
             self.constraint_impulses();
             let mut loosened = false;
             for stage in &mut self.stages {

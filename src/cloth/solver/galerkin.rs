@@ -18,7 +18,7 @@ use super::parallel::{for_each_index, SyncPtr, PAR_MIN};
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ContactCoarsening {
     /// Galerkin coarse operators of the penalised, fixed-filtered fine operator (the default
-    /// since a static hold that pulls slides within its own step, issue 53).
+    /// since a static hold that pulls is let go within its own step, issue 53).
     Galerkin,
     /// Rediscretised coarse cloths with the constraint of the fine particle under each coarse
     /// one, the transfers projecting out the constrained directions.
