@@ -172,7 +172,7 @@ impl Simulation {
         if !self.params.warm_start {
             self.dv.fill(Vec3::zeros());
         }
-        let mut res = self.solve(inp);
+        let mut res = self.solve(inp, false);
         if self.stages_use_impulses() {
             // a stage may loosen the constraints the solve's impulses work against (a static
             // hold that pulls is let go): the step is then solved once more
@@ -186,7 +186,7 @@ impl Simulation {
                     self.z[i] = self.filter.z(i, &self.state.x[i], &self.state.v[i], h);
                 }
                 let first = res.iterations;
-                res = self.solve(inp);
+                res = self.solve(inp, true);
                 res.iterations += first;
                 self.constraint_impulses();
             }
@@ -276,11 +276,19 @@ impl Simulation {
     }
 
     /// The preconditioned CG solve of the assembled system for `dv`, finishing with
-    /// block-Jacobi when a multigrid preconditioner breaks down.
-    fn solve(&mut self, inp: AssemblyInputs) -> PcgResult {
+    /// block-Jacobi when a multigrid preconditioner breaks down. `refilter`: only the filter
+    /// changed since the last solve (the multigrid then rebuilds only what that touches).
+    fn solve(&mut self, inp: AssemblyInputs, refilter: bool) -> PcgResult {
         let mut precond = match (self.mg.as_mut(), self.amg.as_mut()) {
             (Some(mg), _) => {
-                mg.setup(&self.asm.a, &self.state.x, &self.state.v, &self.filter, inp);
+                mg.setup(
+                    &self.asm.a,
+                    &self.state.x,
+                    &self.state.v,
+                    &self.filter,
+                    inp,
+                    refilter,
+                );
                 Preconditioner::Multigrid(mg)
             }
             (None, Some(amg)) => {

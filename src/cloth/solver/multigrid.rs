@@ -8,7 +8,7 @@
 use super::assembly::{Assembly, AssemblyInputs};
 use super::bcsr::{Bcsr3, Sym3f};
 pub use super::galerkin::ContactCoarsening;
-use super::galerkin::{self, FineConstraints, GalerkinTransfer};
+use super::galerkin::{self, Changes, FineConstraints, GalerkinTransfer, HalfProduct};
 use super::line_solver::{weft_order, LineDir, LineSolver};
 use super::parallel::{for_each_mut, PAR_MIN};
 use super::vcycle::{self, Hierarchy};
@@ -211,6 +211,7 @@ struct GalerkinOp {
     a: Bcsr3,
     lines: LineSolver,
     from_fine: GalerkinTransfer,
+    half: HalfProduct,
 }
 
 /// The multigrid hierarchy of one grid cloth.
@@ -223,6 +224,8 @@ pub struct Multigrid {
     galerkin_now: bool,
     /// Accumulated wall time in `setup` and `apply` (s), and the number of applications.
     pub timing: (f64, f64, u64),
+    /// Scratch of a setup after a change of filter only.
+    refit: Changes,
 }
 
 fn sampling(fine: (usize, usize), coarse: (usize, usize)) -> Vec<[(u32, f64); 4]> {
@@ -302,11 +305,21 @@ impl Multigrid {
             });
             (fx, fy) = (cx, cy);
         }
+        // the Galerkin products need a finest pattern coupling particles at most two apart
+        // (every grid cloth's); another keeps the rediscretised levels in contact too
+        let mut contact = ContactCoarsening::from_env();
+        if let Some(c) = levels.get(1) {
+            let t = GalerkinTransfer::new(Transfer::new(levels[0].dims, c.dims).taps, c.dims);
+            if contact == ContactCoarsening::Galerkin && !galerkin::windows_fit(a, &t) {
+                contact = ContactCoarsening::Injected;
+            }
+        }
         Ok(Multigrid {
             levels,
-            contact: ContactCoarsening::from_env(),
+            contact,
             galerkin_now: false,
             timing: (0.0, 0.0, 0),
+            refit: Changes::default(),
         })
     }
 
@@ -339,8 +352,13 @@ impl Multigrid {
     /// (contacts) enter each level's operator as stiff penalty springs κ n nᵀ, so that the
     /// V-cycle approximates the inverse of the constrained system rather than the free one.
     /// While any particle is in contact the coarse levels are instead Galerkin products of
-    /// the level above (with [`ContactCoarsening::Galerkin`], opt-in), which carry every
+    /// the level above (with [`ContactCoarsening::Galerkin`], the default), which carry every
     /// constraint down exactly.
+    ///
+    /// `refilter` says that only the filter changed since the last call (the same matrix `a`,
+    /// the same state: a step solved again after a stage loosened constraints); the Galerkin
+    /// coarse rows are then rebuilt only where a changed particle reaches them, with the same
+    /// result as a full rebuild.
     pub fn setup(
         &mut self,
         a: &Bcsr3,
@@ -348,20 +366,29 @@ impl Multigrid {
         v: &[Vec3],
         filter: &Filter,
         inp: AssemblyInputs,
+        refilter: bool,
     ) {
         let t0 = std::time::Instant::now();
+        let was_galerkin = self.galerkin_now;
         {
             let l0 = &mut self.levels[0];
+            let changed = &mut self.refit.changed;
+            changed.clear();
             l0.penalized = false;
             for (i, k) in filter.kind.iter().enumerate() {
-                l0.fixed[i] = matches!(k, ParticleFilter::Fixed { .. });
-                l0.pen_dir[i] = match k {
+                let fixed = matches!(k, ParticleFilter::Fixed { .. });
+                let dir = match k {
                     ParticleFilter::Normal { normal, .. } => {
                         l0.penalized = true;
                         *normal
                     }
                     _ => Vec3::zeros(),
                 };
+                if fixed != l0.fixed[i] || dir != l0.pen_dir[i] {
+                    changed.push(i as u32);
+                }
+                l0.fixed[i] = fixed;
+                l0.pen_dir[i] = dir;
             }
             if l0.penalized {
                 fill_penalty(a, &l0.pen_dir, &mut l0.pen);
@@ -374,7 +401,8 @@ impl Multigrid {
         }
         self.galerkin_now = self.levels[0].penalized && self.contact == ContactCoarsening::Galerkin;
         if self.galerkin_now {
-            self.setup_galerkin(a);
+            let only_changed = refilter && was_galerkin;
+            self.setup_galerkin(a, only_changed);
             self.timing.0 += t0.elapsed().as_secs_f64();
             return;
         }
@@ -417,8 +445,11 @@ impl Multigrid {
     /// The coarse levels as Galerkin products `Pᵀ Â P` of the level above (see
     /// [`galerkin`]): the finest level's operator with its penalties and fixed particles, each
     /// coarser one from the last. Coarse levels then have no fixed particles or penalties of
-    /// their own. Built on the first call (allocation once per topology).
-    fn setup_galerkin(&mut self, a: &Bcsr3) {
+    /// their own. Built on the first call (allocation once per topology). With `only_changed`,
+    /// each level rebuilds only the rows that the particles in `self.refit.changed` (finest
+    /// level) reach, and passes those rows on as the next level's changed particles.
+    fn setup_galerkin(&mut self, a: &Bcsr3, only_changed: bool) {
+        let work = &mut self.refit;
         for l in 1..self.levels.len() {
             let (fine, coarse) = self.levels.split_at_mut(l);
             let f = &fine[l - 1];
@@ -433,6 +464,7 @@ impl Multigrid {
                     a: ga,
                     lines,
                     from_fine: GalerkinTransfer::new(taps, c.dims),
+                    half: HalfProduct::default(),
                 }
             });
             let (fa, cons) = if l == 1 {
@@ -454,7 +486,14 @@ impl Multigrid {
                     },
                 )
             };
-            galerkin::fill(fa, cons, &gal.from_fine, &mut gal.a);
+            if only_changed {
+                work.reach(fa, &gal.from_fine);
+            }
+            let changes = only_changed.then_some(&*work);
+            galerkin::fill(fa, cons, &gal.from_fine, &mut gal.half, &mut gal.a, changes);
+            if only_changed {
+                work.descend();
+            }
             c.fixed.fill(false);
             c.penalized = false;
             gal.lines.factor(&gal.a, &c.fixed, None);
