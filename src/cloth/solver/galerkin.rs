@@ -258,7 +258,10 @@ pub fn fill(
     coarse: &mut Bcsr3,
     changes: Option<&Changes>,
 ) {
-    debug_assert!(windows_fit(fine, t), "a fine pattern wider than the windows");
+    debug_assert!(
+        windows_fit(fine, t),
+        "a fine pattern wider than the windows"
+    );
     let coarse_only = changes.map(|c| &c.coarse_rows[..]);
     half.rows.resize(fine.rows(), [Sym3f::default(); HW * HW]);
     half_rows(
