@@ -9,6 +9,7 @@ pub mod assembly;
 pub mod bcsr;
 pub(crate) mod contribution;
 pub mod galerkin;
+mod grid_transfer;
 pub mod line_solver;
 pub mod multigrid;
 pub mod parallel;
