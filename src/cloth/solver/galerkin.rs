@@ -406,7 +406,13 @@ multiversion! {
 multiversion! {
     /// The coarse rows `Pᵀ (Â P)` from the half product: every row, or those `only` lists.
     fn coarse_rows(t: &GalerkinTransfer, half: &[HalfRow], coarse: &mut Bcsr3, only: Option<&[u32]>) {
-        each_coarse_row(t.cx, coarse, only, |c, (ci, cj), acc| {
+        let nc = only.map_or(coarse.rows(), |o| o.len());
+        let cx = t.cx;
+        let out = CoarseOut::new(coarse);
+        for_each_index(nc, nc >= PAR_MIN, |idx| {
+            let c = only.map_or(idx, |o| o[idx] as usize);
+            let (ci, cj) = ((c / cx) as i32, (c % cx) as i32);
+            let mut acc = [Sym3::default(); W];
             for &(f, w) in &t.rev[t.rev_ptr[c]..t.rev_ptr[c + 1]] {
                 let (ai, aj) = t.anchor[f as usize];
                 // the window's first row and column in the 5 × 5 stencil (0 or 1)
@@ -419,26 +425,8 @@ multiversion! {
                     }
                 }
             }
+            // SAFETY: row c belongs to this task alone.
+            unsafe { write_row(&out, c, (ci, cj), cx, &acc) };
         });
     }
-}
-
-/// Sums and writes coarse rows, every row or those `only` lists, in parallel: `row(c, (ci,
-/// cj), acc)` adds row `c`'s 5 × 5 stencil (grid row `ci`, column `cj`) into `acc`, zero on
-/// entry; `cx` is the coarse grid's width.
-#[inline(always)]
-fn each_coarse_row<F>(cx: usize, coarse: &mut Bcsr3, only: Option<&[u32]>, row: F)
-where
-    F: Fn(usize, (i32, i32), &mut [Sym3; W]) + Sync + Send,
-{
-    let nc = only.map_or(coarse.rows(), |o| o.len());
-    let out = CoarseOut::new(coarse);
-    for_each_index(nc, nc >= PAR_MIN, |idx| {
-        let c = only.map_or(idx, |o| o[idx] as usize);
-        let at = ((c / cx) as i32, (c % cx) as i32);
-        let mut acc = [Sym3::default(); W];
-        row(c, at, &mut acc);
-        // SAFETY: row c belongs to this task alone.
-        unsafe { write_row(&out, c, at, cx, &acc) };
-    });
 }

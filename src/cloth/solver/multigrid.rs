@@ -230,7 +230,7 @@ impl Multigrid {
                     }
                     _ => Vec3::zeros(),
                 };
-                if fixed != l0.fixed[i] || dir != l0.pen_dir[i] {
+                if refilter && (fixed != l0.fixed[i] || dir != l0.pen_dir[i]) {
                     changed.push(i as u32);
                 }
                 l0.fixed[i] = fixed;
