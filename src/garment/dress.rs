@@ -9,6 +9,7 @@ use std::time::Instant;
 use super::mesh::graph::Adjacency;
 use super::mesh::{mesh_pattern, GarmentMesh, MeshParameters};
 use super::placement::preposition::{preposition, PrepositionParameters, PrepositionReport};
+use super::seam_closure::close_crossed_seams;
 use super::seam_hinges::seam_hinges;
 use super::{BodyFrame, Pattern, PatternError, Silhouettes};
 use crate::body::Mannequin;
@@ -83,6 +84,9 @@ pub struct DressReport {
     /// Crossings of a piece with itself left after the pre-positioned knots were smoothed
     /// open (see the pass-through zones).
     pub knots_left: usize,
+    /// Crossings between the two pieces of a seam (not a centre seam) left after the
+    /// stretches of seam near them were sewn shut at once.
+    pub seam_crossings_left: usize,
     /// Intersecting edge–triangle pairs at the start of the simulation.
     pub crossings: usize,
 }
@@ -185,6 +189,14 @@ pub fn dress(
         &mut sim.state.x,
     );
     let knots_left = untangle_knots(&garment, &mut sim);
+    // where two pieces cross at a seam joining them (not a centre seam), that stretch of the
+    // seam is sewn shut at once
+    let centre: Vec<usize> = centre_seams(pattern, &garment)
+        .into_iter()
+        .map(|c| c.0)
+        .collect();
+    let seam_crossings_left =
+        close_crossed_seams(&garment, &centre, 2.0 * params.mesh.edge_length, &mut sim);
     let x = sim.state.x.clone();
     // where pre-positioning left two pieces of a centre seam crossing each other, or a piece
     // through itself (the crotch of trousers), they may pass through each other near there
@@ -201,6 +213,7 @@ pub fn dress(
         preposition: pre,
         closing_time: sewing.closing_time(),
         knots_left,
+        seam_crossings_left,
         crossings: crossings.len(),
     };
     sewing.sewing_gravity = params.sewing_gravity;
@@ -299,7 +312,7 @@ fn keep_to_sides(
 }
 
 /// Smoothing rounds of [`untangle_knots`].
-const KNOT_ROUNDS: usize = 12;
+const KNOT_ROUNDS: usize = 48;
 
 /// Opens the small knots pre-positioning can leave where a piece is laid through itself (a
 /// few neighbouring triangles turned through each other at the crotch): the vertices of each

@@ -1,7 +1,7 @@
 //! Garments from 2D sewing patterns: pattern pieces and seams ([`pattern`]) with their
 //! outlines, checks and expansion, their files ([`formats`]: JSON, SVG, DXF-AAMA, pattern
 //! sheets), meshing of the pieces ([`mesh`]), automatic placement around a mannequin
-//! ([`placement`]) and sewing into one cloth ([`mod@dress`], [`seam_hinges`]).
+//! ([`placement`]) and sewing into one cloth ([`mod@dress`], [`seam_hinges`], seam closure at crossings).
 
 pub mod dress;
 pub mod error;
@@ -12,6 +12,7 @@ pub mod mesh;
 pub mod outline;
 pub mod pattern;
 pub mod placement;
+mod seam_closure;
 pub mod seam_hinges;
 pub mod validate;
 
