@@ -198,3 +198,18 @@ fn paco_is_sewn_without_self_intersection_at_other_mesh_sizes() {
         assert!(x.iter().all(|p| p.iter().all(|c| c.is_finite())));
     }
 }
+
+#[test]
+fn penelope_side_seam_laid_crossing_at_8mm_is_sewn_shut_before_sewing() {
+    // regression: at 8 mm edges pre-positioning laid the skirt's right side seam with the
+    // front's seam edge through a triangle of the left back next to it (the two seam lines
+    // 1.5 mm apart, shifted along the seam by one vertex); self-collision then held the
+    // crossing and the seam stayed 7.2 mm open with 2 intersections. Now that stretch of the
+    // seam is sewn shut before sewing starts.
+    sew_at(
+        "penelope",
+        Some("kawabata/fabrics/suiting-hesc.json"),
+        1.5,
+        0.008,
+    );
+}
