@@ -68,6 +68,13 @@ pub trait StepStage: Send + Sync + std::fmt::Debug + Any {
         false
     }
 
+    /// Whether [`StepStage::loosen`] may change anything on this step (it holds constraints
+    /// it may let go): the simulation then judges the impulses on a first solve to a looser
+    /// tolerance (default: no).
+    fn may_loosen(&self) -> bool {
+        false
+    }
+
     /// After a solve, before the new positions: loosens the constraints whose `impulse`
     /// (momentum, from the solve's residual) works against them, by changing the `filter`;
     /// returns whether any changed, and the step is then solved again with the new filter

@@ -233,6 +233,12 @@ impl Collisions {
         self.ms = t0.elapsed().as_secs_f64() * 1e3;
     }
 
+    /// Whether this step holds any particle by static friction (set by `begin_step`): only
+    /// then may [`Collisions::release_pulling_holds`] let one go.
+    pub fn holds_any(&self) -> bool {
+        self.slots.iter().any(|s| s.body != NO_BODY && s.stuck)
+    }
+
     /// After a solve: a particle held by static friction whose normal impulse (`impulse`,
     /// momentum, from the solve's residual) pulls it onto the body is not held: in `filter`
     /// it becomes free where it lies outside 0.9 times the thickness, a sliding contact (its

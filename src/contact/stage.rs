@@ -62,6 +62,10 @@ impl StepStage for Collisions {
         self.is_active()
     }
 
+    fn may_loosen(&self) -> bool {
+        self.is_active() && self.holds_any()
+    }
+
     fn loosen(&mut self, impulse: &[Vec3], filter: &mut Filter) -> bool {
         self.is_active() && self.release_pulling_holds(impulse, filter)
     }
