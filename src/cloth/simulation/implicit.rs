@@ -19,8 +19,8 @@ use crate::geometry::Vec3;
 /// CG tolerance: the impulses that decide which holds pull are judged there, and the solve goes
 /// on to the full tolerance after. Judged on a fully converged first solve, a drape spent the
 /// last one to two iterations of nearly every substep on a solution the release then
-/// perturbed (a few dozen holds pull on most substeps): 128² drape 8.5 → 6.2 iterations per
-/// substep with 10 (5: 6.9, 20: 6.5; 64²: 8.7 → 6.8).
+/// perturbed (a few dozen holds pull on most substeps): drape 8.5 → 6.46 iterations per
+/// substep at 128² and 8.7 → 6.52 at 64² with 10 (5 and 20 gave about 6.9 and 6.5 at 128²).
 const LOOSEN_TOLERANCE_FACTOR: f64 = 10.0;
 
 /// How a solve starts: which part of the preconditioner is built first.
