@@ -2,6 +2,7 @@
 //! demo scene that `emilion` runs with no arguments.
 
 pub mod sampling;
+pub mod vibration;
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};

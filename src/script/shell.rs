@@ -1,6 +1,7 @@
 //! Script bindings of the meshless Kirchhoff–Love shell: its benchmark cases (the work lives in
 //! `crate::shell::benchmarks`), the KES rigs on it (`crate::kes::shell_rigs`) and the
-//! sampling-independence study against the mass-spring cloth (`crate::scenes::sampling`).
+//! sampling-independence study against the mass-spring cloth (`crate::scenes::sampling`) and
+//! the vibrating strip (`crate::scenes::vibration`).
 
 use rhai::{Array, Dynamic, Map, INT};
 
@@ -99,8 +100,75 @@ fn sampling_run(f: &super::kes::KesFabric, scene: &str, model: &str, n: INT) -> 
     Ok(m)
 }
 
+/// One run of the vibrating strip (`shell::vibration`).
+fn vibration(f: &super::kes::KesFabric, model: &str, along: INT, options: &Map) -> RResult<Map> {
+    use crate::scenes::sampling::linear_fabric;
+    use crate::scenes::vibration::{mass_spring_vibration, shell_vibration};
+    let (mut length, mut steps) = (0.2, 100usize);
+    for (k, v) in options {
+        match k.as_str() {
+            "length" => {
+                length = v
+                    .as_float()
+                    .map_err(|_| rt_err("shell::vibration: option `length` must be a float (m)"))?
+            }
+            "steps_per_period" => {
+                steps = v
+                    .as_int()
+                    .ok()
+                    .and_then(|n| usize::try_from(n).ok())
+                    .ok_or_else(|| {
+                        rt_err("shell::vibration: option `steps_per_period` must be an int ≥ 0")
+                    })?
+            }
+            other => {
+                return Err(rt_err(format!(
+                    "shell::vibration: unknown option `{other}` (length, steps_per_period)"
+                )))
+            }
+        }
+    }
+    let along = usize::try_from(along).map_err(|_| {
+        rt_err(format!(
+            "shell::vibration: `along` must lie in [5, 201], got {along}"
+        ))
+    })?;
+    let (params, law) = crate::kes::lab::measured_fabric(&f.0).map_err(rt_err)?;
+    let fabric = linear_fabric(std::sync::Arc::new(law), params.density).map_err(rt_err)?;
+    let row = match model {
+        "shell" => shell_vibration(&fabric, length, along, steps),
+        "mass-spring" => mass_spring_vibration(&fabric, length, along, steps),
+        other => Err(format!(
+            "shell::vibration: model must be \"shell\" or \"mass-spring\", got {other:?}"
+        )),
+    }
+    .map_err(rt_err)?;
+    let mut m = Map::new();
+    m.insert("model".into(), Dynamic::from(row.model.to_string()));
+    m.insert("along".into(), Dynamic::from_int(row.along as INT));
+    m.insert("period".into(), Dynamic::from_float(row.period));
+    m.insert("reference".into(), Dynamic::from_float(row.reference));
+    m.insert("error_pct".into(), Dynamic::from_float(row.error_pct));
+    m.insert(
+        "amplitude_kept".into(),
+        Dynamic::from_float(row.amplitude_kept),
+    );
+    m.insert("steps".into(), Dynamic::from_int(row.steps as INT));
+    m.insert(
+        "iterations".into(),
+        Dynamic::from_int(row.iterations as INT),
+    );
+    m.insert("seconds".into(), Dynamic::from_float(row.seconds));
+    Ok(m)
+}
+
 /// Registers the shell functions.
 pub fn register(engine: &mut ApiBuilder) {
+    function!(engine, "shell::vibration", ["fabric: KesFabric", "model: String", "along: int", "options: Map", "Map"],
+        "The vibrating strip (docs/shell.md): a strip of the fabric's linear law (length 0.2 m,\nwidth a quarter of it, warp along it), clamped at one end, no gravity, released from its\nfirst mode shape (tip amplitude 1 % of the length) and run for three analytic periods;\n`model` \"shell\" (meshless shell, Newmark, consistent mass) or \"mass-spring\" (the cloth's\nimplicit solver), `along` points (5 to 201) along the strip. Options: `length` (m, 0.2),\n`steps_per_period` (100). Returns #{model, along, period (s, from the tip's zero\ncrossings), reference (2π/ω₁ of Euler–Bernoulli), error_pct, amplitude_kept (last period's\nlargest tip excursion over the first), steps, iterations (Newton or CG, in all), seconds}.",
+        |f: super::kes::KesFabric, model: &str, along: INT, options: Map| -> RResult<Map> {
+            vibration(&f, model, along, &options)
+        });
     function!(engine, "shell::sampling_run", ["fabric: KesFabric", "scene: String", "model: String", "n: int", "Map"],
         "One run of the sampling-independence study (docs/shell.md): a 1 m square of the fabric's\nlinear law (initial slopes of its measured law) on `n` × `n` points (odd, 5 to 201), `scene`\n\"drape\" (over a 0.3 m sphere, centre held: the drape coefficient), \"hang\" (from the\ntop corners: the sag of the top edge's middle, m) or \"hang_clips\" (held by 5 cm square\nclips at the top corners), `model` \"shell\" (relaxed to\nequilibrium) or \"mass-spring\" (run until still). Returns #{model, scene, per_side,\nspacing (m), value, steps (Newton iterations or time steps), seconds, settled (false: the\nmass-spring cloth still moved after 60 s; its last value)}.",
         |f: super::kes::KesFabric, scene: &str, model: &str, n: INT| -> RResult<Map> {

@@ -13,6 +13,7 @@
 //! measured (nonlinear) law, [`moment`] edge moments, [`problem`] problems and parameters,
 //! [`discretisation`] background cells and quadrature, [`assembly`] residual and tangent,
 //! [`solve`] Newton, [`relax`] relaxation to a stable equilibrium (overdamped implicit steps),
+//! [`dynamics`] time-accurate implicit dynamics (Newmark, backward Euler),
 //! [`obstacle`] contact with a sphere, [`display`] the triangulated display surface,
 //! [`benchmarks`] the shell obstacle course.
 
@@ -20,6 +21,7 @@ pub mod assembly;
 pub mod benchmarks;
 pub mod discretisation;
 pub mod display;
+pub mod dynamics;
 pub mod error;
 pub mod fabric_law;
 pub mod jet;

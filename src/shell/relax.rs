@@ -9,15 +9,13 @@
 
 use std::time::Instant;
 
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt, SymbolicLu};
-use faer::sparse::{SparseColMat, Triplet};
-use faer::Side;
+use faer::sparse::Triplet;
 
 use super::assembly::{residual_and_triplets, tangent_matrix, Entry};
 use super::discretisation::Discretisation;
 use super::error::ShellError;
 use super::obstacle::SphereObstacle;
-use super::solve::{apply_update, newton_update};
+use super::solve::{newton_step, Symbolic};
 use crate::limits;
 
 /// How a relaxation proceeds.
@@ -74,35 +72,6 @@ pub fn lumped_masses(disc: &Discretisation) -> Vec<f64> {
     let mean = m.iter().sum::<f64>() / m.len().max(1) as f64;
     let floor = 1e-6 * mean.abs().max(f64::MIN_POSITIVE);
     m.iter().map(|&v| v.max(floor)).collect()
-}
-
-/// The symbolic factorisations, computed once (the pattern does not change).
-#[derive(Default)]
-struct Symbolic {
-    llt: Option<SymbolicLlt<usize>>,
-    lu: Option<SymbolicLu<usize>>,
-}
-
-/// One Newton update u −= K⁻¹ r: Cholesky (half the work of LU) while K is positive
-/// definite, which the inertia term makes it at small steps; LU when it is not.
-fn newton_step(
-    r: &[f64],
-    k: &SparseColMat<usize, f64>,
-    u: &mut [f64],
-    symbolic: &mut Symbolic,
-) -> Result<(), ShellError> {
-    if symbolic.llt.is_none() {
-        symbolic.llt = Some(
-            SymbolicLlt::try_new(k.symbolic(), Side::Lower).map_err(|e| {
-                ShellError::Solver(format!("symbolic Cholesky of the tangent failed: {e:?}"))
-            })?,
-        );
-    }
-    let sym = symbolic.llt.clone().expect("set above");
-    match Llt::try_new_with_symbolic(sym, k.as_ref(), Side::Lower) {
-        Ok(llt) => apply_update(&llt, r, u).map(|_| ()),
-        Err(_) => newton_update(r, k, u, &mut symbolic.lu).map(|_| ()),
-    }
 }
 
 fn norm(v: &[f64]) -> f64 {

@@ -6,9 +6,9 @@
 //! factorisation is redone. The linear solution is one Newton step from the rest state.
 
 use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::linalg::solvers::{Llt, Lu, SymbolicLlt, SymbolicLu};
 use faer::sparse::SparseColMat;
-use faer::Col;
+use faer::{Col, Side};
 
 use super::assembly::residual_and_tangent;
 use super::discretisation::Discretisation;
@@ -68,6 +68,35 @@ pub(crate) fn apply_update(
         step = step.max(du[i].abs());
     }
     Ok(step)
+}
+
+/// The symbolic factorisations, computed once (the pattern does not change).
+#[derive(Default)]
+pub(crate) struct Symbolic {
+    llt: Option<SymbolicLlt<usize>>,
+    lu: Option<SymbolicLu<usize>>,
+}
+
+/// One Newton update u −= K⁻¹ r: Cholesky (half the work of LU) while K is positive
+/// definite, which the inertia term makes it at small steps; LU when it is not.
+pub(crate) fn newton_step(
+    r: &[f64],
+    k: &SparseColMat<usize, f64>,
+    u: &mut [f64],
+    symbolic: &mut Symbolic,
+) -> Result<(), ShellError> {
+    if symbolic.llt.is_none() {
+        symbolic.llt = Some(
+            SymbolicLlt::try_new(k.symbolic(), Side::Lower).map_err(|e| {
+                ShellError::Solver(format!("symbolic Cholesky of the tangent failed: {e:?}"))
+            })?,
+        );
+    }
+    let sym = symbolic.llt.clone().expect("set above");
+    match Llt::try_new_with_symbolic(sym, k.as_ref(), Side::Lower) {
+        Ok(llt) => apply_update(&llt, r, u).map(|_| ()),
+        Err(_) => newton_update(r, k, u, &mut symbolic.lu).map(|_| ()),
+    }
 }
 
 /// The linear (small-displacement) solution under the full load: one Newton step from rest.
