@@ -48,6 +48,7 @@ const QUICK: &[(&str, &[&str])] = &[
     ),
     ("golf_track", &["frames=2", "adapt_body=false"]),
     ("facades_eval", &["limit=2"]),
+    ("facade_train", &["max_images=2", "samples=500", "trees=3"]),
     ("all", &["meshes=coarse", "limit=1"]),
     ("bending", &["meshes=coarse"]),
     ("shear", &["meshes=coarse"]),
