@@ -12,11 +12,12 @@
 //! energy density, [`material`] the linear laws, [`fabric_law`] a fabric's
 //! measured (nonlinear) law, [`moment`] edge moments, [`problem`] problems and parameters,
 //! [`discretisation`] background cells and quadrature, [`assembly`] residual and tangent,
-//! [`solve`] Newton, [`relax`] relaxation to a stable equilibrium (overdamped implicit steps),
+//! [`solve`] Newton, [`arc_length`] paths through buckling and limit points, [`relax`] relaxation to a stable equilibrium (overdamped implicit steps),
 //! [`dynamics`] time-accurate implicit dynamics (Newmark, backward Euler),
 //! [`obstacle`] contact with a sphere, [`display`] the triangulated display surface,
 //! [`benchmarks`] the shell obstacle course.
 
+pub mod arc_length;
 pub mod assembly;
 pub mod benchmarks;
 pub mod discretisation;

@@ -77,6 +77,36 @@ pub(crate) struct Symbolic {
     lu: Option<SymbolicLu<usize>>,
 }
 
+impl Symbolic {
+    /// The symbolic Cholesky of `k`'s pattern, computed on the first call.
+    pub(crate) fn llt(
+        &mut self,
+        k: &SparseColMat<usize, f64>,
+    ) -> Result<SymbolicLlt<usize>, ShellError> {
+        if self.llt.is_none() {
+            self.llt = Some(
+                SymbolicLlt::try_new(k.symbolic(), Side::Lower).map_err(|e| {
+                    ShellError::Solver(format!("symbolic Cholesky of the tangent failed: {e:?}"))
+                })?,
+            );
+        }
+        Ok(self.llt.clone().expect("set above"))
+    }
+
+    /// The symbolic LU of `k`'s pattern, computed on the first call.
+    pub(crate) fn lu(
+        &mut self,
+        k: &SparseColMat<usize, f64>,
+    ) -> Result<SymbolicLu<usize>, ShellError> {
+        if self.lu.is_none() {
+            self.lu = Some(SymbolicLu::try_new(k.symbolic()).map_err(|e| {
+                ShellError::Solver(format!("symbolic LU of the tangent failed: {e:?}"))
+            })?);
+        }
+        Ok(self.lu.clone().expect("set above"))
+    }
+}
+
 /// One Newton update u −= K⁻¹ r: Cholesky (half the work of LU) while K is positive
 /// definite, which the inertia term makes it at small steps; LU when it is not.
 pub(crate) fn newton_step(
@@ -85,15 +115,7 @@ pub(crate) fn newton_step(
     u: &mut [f64],
     symbolic: &mut Symbolic,
 ) -> Result<(), ShellError> {
-    if symbolic.llt.is_none() {
-        symbolic.llt = Some(
-            SymbolicLlt::try_new(k.symbolic(), Side::Lower).map_err(|e| {
-                ShellError::Solver(format!("symbolic Cholesky of the tangent failed: {e:?}"))
-            })?,
-        );
-    }
-    let sym = symbolic.llt.clone().expect("set above");
-    match Llt::try_new_with_symbolic(sym, k.as_ref(), Side::Lower) {
+    match Llt::try_new_with_symbolic(symbolic.llt(k)?, k.as_ref(), Side::Lower) {
         Ok(llt) => apply_update(&llt, r, u).map(|_| ()),
         Err(_) => newton_update(r, k, u, &mut symbolic.lu).map(|_| ()),
     }

@@ -1,0 +1,107 @@
+//! Arc length through buckling (`src/shell/arc_length.rs`), against the elastica: a clamped
+//! strip compressed by a dead end load buckles at P_cr = π² EI / (4 L²) and its post-buckling
+//! path is P / P_cr = (2 K(k) / π)², k = sin(α/2), α the free end's rotation (K the complete
+//! elliptic integral of the first kind).
+
+use emilion::shell::arc_length::{arc_length, ArcLengthParameters};
+use emilion::shell::problem::{grid_nodes, Constraint, Direction};
+use emilion::shell::{Discretisation, ShellMaterial, ShellParameters, ShellProblem, Surface};
+
+/// K(k) by the arithmetic–geometric mean.
+fn elliptic_k(k: f64) -> f64 {
+    let (mut a, mut g) = (1.0, (1.0 - k * k).sqrt());
+    while (a - g).abs() > 1e-15 {
+        (a, g) = (0.5 * (a + g), (a * g).sqrt());
+    }
+    std::f64::consts::PI / (2.0 * a)
+}
+
+/// P / P_cr of the clamped–free elastica whose free end has turned by `alpha` (rad).
+fn elastica_load(alpha: f64) -> f64 {
+    (2.0 * elliptic_k((0.5 * alpha).sin()) / std::f64::consts::PI).powi(2)
+}
+
+#[test]
+fn the_elliptic_integral_has_its_tabulated_values() {
+    assert!((elliptic_k(0.0) - std::f64::consts::FRAC_PI_2).abs() < 1e-14);
+    assert!((elliptic_k(0.5) - 1.685_750_354_812_596).abs() < 1e-12);
+    assert!((elliptic_k(0.5f64.sqrt()) - 1.854_074_677_301_372).abs() < 1e-12);
+}
+
+#[test]
+fn a_compressed_strip_follows_the_elastica_through_buckling() {
+    let (l, b, t) = (1.0, 0.1, 0.01);
+    let e = 12.0 / (t * t * t); // D = E t³/12 = 1 N·m, EI = D b
+    let p_cr = std::f64::consts::PI.powi(2) * b / (4.0 * l * l);
+    let fixed = |v: [f64; 3]| Direction::Fixed(v);
+    let domain = [0.0, l, 0.0, b];
+    // the end load P_cr along −x over the free edge (¼, ½, ¼), tilted by a thousandth of a
+    // radian downwards: the imperfection that picks the buckling direction
+    let point_loads = [(0.0, 0.25), (0.5 * b, 0.5), (b, 0.25)]
+        .iter()
+        .map(|&(y, w)| ([l, y], [-w * p_cr, 0.0, -1e-3 * w * p_cr]))
+        .collect();
+    let problem = ShellProblem {
+        surface: Surface::Plane,
+        domain,
+        nodes: grid_nodes(domain, 21, 3),
+        material: ShellMaterial::isotropic(e, 0.0, t, 0.0).unwrap(),
+        edges: [
+            vec![
+                Constraint::Value(fixed([1.0, 0.0, 0.0])),
+                Constraint::Value(fixed([0.0, 1.0, 0.0])),
+                Constraint::Value(fixed([0.0, 0.0, 1.0])),
+                Constraint::Slope(Direction::Normal),
+            ],
+            vec![],
+            vec![],
+            vec![],
+        ],
+        pins: vec![],
+        area_load: [0.0; 3],
+        point_loads,
+    };
+    let disc = Discretisation::new(problem, ShellParameters::default()).unwrap();
+    let params = ArcLengthParameters {
+        step: 0.02,
+        max_step: 0.5,
+        ..Default::default()
+    };
+    let (mut u, mut lambda) = (Vec::new(), 0.0);
+    let mut rows = Vec::new();
+    let path = arc_length(&disc, &mut u, &mut lambda, &params, &mut |lam, u| {
+        let f = disc.field_at([l, 0.5 * b], u).unwrap();
+        let a1 = nalgebra::Vector3::x() + f[1];
+        let alpha = (-a1.z).atan2(a1.x);
+        rows.push((alpha.to_degrees(), lam, elastica_load(alpha)));
+        alpha < 120f64.to_radians()
+    })
+    .unwrap();
+    let mut worst = 0.0f64;
+    for &(alpha, lam, reference) in &rows {
+        let err = (lam - reference) / reference;
+        println!(
+            "α {alpha:7.2}°  P/P_cr {lam:.5}  elastica {reference:.5}  {:+.3} %",
+            100.0 * err
+        );
+        if alpha >= 10.0 {
+            worst = worst.max(err.abs());
+        }
+    }
+    let iterations: usize = path.iter().map(|p| p.iterations).sum();
+    println!(
+        "{} points, {iterations} corrector iterations, worst {:.3} %",
+        path.len(),
+        100.0 * worst
+    );
+    assert!(
+        rows.last().unwrap().0 >= 120.0,
+        "the path stopped at {:?}",
+        rows.last()
+    );
+    assert!(
+        rows.iter().filter(|r| r.0 >= 10.0).count() >= 8,
+        "too few points past 10°"
+    );
+    assert!(worst < 0.01, "worst error {worst} against the elastica");
+}
