@@ -351,6 +351,8 @@ fn run_lab_script(name: &str, sets: &[(&str, String)]) -> String {
     String::from_utf8_lossy(&o.stdout).to_string()
 }
 
+/// The lab scripts on the coarse rig mesh (the rigs' accuracy on both meshes is tested in
+/// `tests/kes.rs`; here the scripts, their printout and their plots).
 #[test]
 fn lab_scripts_run_and_write_plots() {
     let fabric = root().join("tests/data/fabrics_small/shirting-cotton.json");
@@ -361,6 +363,7 @@ fn lab_scripts_run_and_write_plots() {
             &[
                 ("fabric", fabric.display().to_string()),
                 ("out", out.display().to_string()),
+                ("meshes", "coarse".into()),
             ],
         );
         assert!(stdout.contains("measured"), "{name}: {stdout}");
@@ -376,7 +379,13 @@ fn lab_scripts_run_and_write_plots() {
             .count();
         assert!(pngs >= 1, "{name}: no plot in {}", out.display());
     }
-    let stdout = run_lab_script("fit", &[("fabric", fabric.display().to_string())]);
+    let stdout = run_lab_script(
+        "fit",
+        &[
+            ("fabric", fabric.display().to_string()),
+            ("tests", "tensile".into()),
+        ],
+    );
     assert!(stdout.contains("fitted stretch_damping"), "{stdout}");
 }
 
