@@ -185,33 +185,20 @@ fn kes_tensile_and_bending_rigs_on_the_shell_give_back_measured_curves_within_th
 /// now with a mass so that the inertia term acts.
 #[test]
 fn relaxation_reaches_the_elastica_of_the_heavy_cantilever_within_one_degree() {
-    use emilion::shell::problem::{Constraint, Direction};
     use emilion::shell::relax::{relax, RelaxParameters};
     let (l, b, t) = (1.0, 0.1, 0.01);
     let e = 12.0 / (t * t * t); // B = E t³/12 = 1 N·m
     let (lam, reference) = ELASTICA_TIP_ANGLES[4];
     assert_eq!(lam, 10.0);
-    let domain = [0.0, l, 0.0, b];
-    let fixed = |v: [f64; 3]| Direction::Fixed(v);
     let problem = ShellProblem {
-        surface: Surface::Plane,
-        domain,
-        nodes: grid_nodes(domain, 21, 3),
-        material: ShellMaterial::isotropic(e, 0.0, t, 1.0).unwrap(),
-        edges: [
-            vec![
-                Constraint::Value(fixed([1.0, 0.0, 0.0])),
-                Constraint::Value(fixed([0.0, 1.0, 0.0])),
-                Constraint::Value(fixed([0.0, 0.0, 1.0])),
-                Constraint::Slope(Direction::Normal),
-            ],
-            vec![],
-            vec![],
-            vec![],
-        ],
-        pins: vec![],
         area_load: [0.0, 0.0, -lam / (l * l * l)],
-        point_loads: vec![],
+        ..ShellProblem::clamped_strip(
+            l,
+            b,
+            21,
+            3,
+            ShellMaterial::isotropic(e, 0.0, t, 1.0).unwrap(),
+        )
     };
     let disc = Discretisation::new(problem, ShellParameters::default()).unwrap();
     let mut u = Vec::new();

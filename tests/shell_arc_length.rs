@@ -4,8 +4,7 @@
 //! elliptic integral of the first kind).
 
 use emilion::shell::arc_length::{arc_length, ArcLengthParameters};
-use emilion::shell::problem::{grid_nodes, Constraint, Direction};
-use emilion::shell::{Discretisation, ShellMaterial, ShellParameters, ShellProblem, Surface};
+use emilion::shell::{Discretisation, ShellMaterial, ShellParameters, ShellProblem};
 
 /// K(k) by the arithmetic–geometric mean.
 fn elliptic_k(k: f64) -> f64 {
@@ -33,8 +32,6 @@ fn a_compressed_strip_follows_the_elastica_through_buckling() {
     let (l, b, t) = (1.0, 0.1, 0.01);
     let e = 12.0 / (t * t * t); // D = E t³/12 = 1 N·m, EI = D b
     let p_cr = std::f64::consts::PI.powi(2) * b / (4.0 * l * l);
-    let fixed = |v: [f64; 3]| Direction::Fixed(v);
-    let domain = [0.0, l, 0.0, b];
     // the end load P_cr along −x over the free edge (¼, ½, ¼), tilted by a thousandth of a
     // radian downwards: the imperfection that picks the buckling direction
     let point_loads = [(0.0, 0.25), (0.5 * b, 0.5), (b, 0.25)]
@@ -42,24 +39,14 @@ fn a_compressed_strip_follows_the_elastica_through_buckling() {
         .map(|&(y, w)| ([l, y], [-w * p_cr, 0.0, -1e-3 * w * p_cr]))
         .collect();
     let problem = ShellProblem {
-        surface: Surface::Plane,
-        domain,
-        nodes: grid_nodes(domain, 21, 3),
-        material: ShellMaterial::isotropic(e, 0.0, t, 0.0).unwrap(),
-        edges: [
-            vec![
-                Constraint::Value(fixed([1.0, 0.0, 0.0])),
-                Constraint::Value(fixed([0.0, 1.0, 0.0])),
-                Constraint::Value(fixed([0.0, 0.0, 1.0])),
-                Constraint::Slope(Direction::Normal),
-            ],
-            vec![],
-            vec![],
-            vec![],
-        ],
-        pins: vec![],
-        area_load: [0.0; 3],
         point_loads,
+        ..ShellProblem::clamped_strip(
+            l,
+            b,
+            21,
+            3,
+            ShellMaterial::isotropic(e, 0.0, t, 0.0).unwrap(),
+        )
     };
     let disc = Discretisation::new(problem, ShellParameters::default()).unwrap();
     let params = ArcLengthParameters {

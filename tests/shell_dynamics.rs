@@ -4,8 +4,7 @@
 //! energy (through a large, nonlinear swing) while backward Euler damps them.
 
 use emilion::shell::dynamics::{potential_energy, DynamicsParameters, Integrator, ShellDynamics};
-use emilion::shell::problem::{grid_nodes, Constraint, Direction};
-use emilion::shell::{Discretisation, ShellMaterial, ShellParameters, ShellProblem, Surface};
+use emilion::shell::{Discretisation, ShellMaterial, ShellParameters, ShellProblem};
 
 const L: f64 = 1.0;
 const B: f64 = 0.1;
@@ -17,27 +16,15 @@ const BETA_L: f64 = 1.875_104_068_711_961;
 fn strip(n: usize, q: f64) -> Discretisation {
     let t = 0.01;
     let e = 12.0 / (t * t * t);
-    let fixed = |v: [f64; 3]| Direction::Fixed(v);
-    let domain = [0.0, L, 0.0, B];
     let problem = ShellProblem {
-        surface: Surface::Plane,
-        domain,
-        nodes: grid_nodes(domain, n, 3),
-        material: ShellMaterial::isotropic(e, 0.0, t, 1.0).unwrap(),
-        edges: [
-            vec![
-                Constraint::Value(fixed([1.0, 0.0, 0.0])),
-                Constraint::Value(fixed([0.0, 1.0, 0.0])),
-                Constraint::Value(fixed([0.0, 0.0, 1.0])),
-                Constraint::Slope(Direction::Normal),
-            ],
-            vec![],
-            vec![],
-            vec![],
-        ],
-        pins: vec![],
         area_load: [0.0, 0.0, -q],
-        point_loads: vec![],
+        ..ShellProblem::clamped_strip(
+            L,
+            B,
+            n,
+            3,
+            ShellMaterial::isotropic(e, 0.0, t, 1.0).unwrap(),
+        )
     };
     Discretisation::new(problem, ShellParameters::default()).unwrap()
 }

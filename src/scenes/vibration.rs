@@ -17,9 +17,8 @@ use std::time::Instant;
 
 use crate::cloth::{ClothModel, FabricParameters, Simulation, SimulationParameters};
 use crate::shell::dynamics::{DynamicsParameters, Integrator, ShellDynamics};
-use crate::shell::problem::{grid_nodes, Constraint, Direction};
 use crate::shell::solve::solve_static;
-use crate::shell::{Discretisation, ShellMaterial, ShellParameters, ShellProblem, Surface};
+use crate::shell::{Discretisation, ShellMaterial, ShellParameters, ShellProblem};
 
 /// β₁ L of the first clamped–free mode.
 pub const BETA_L: f64 = 1.875_104_068_711_961;
@@ -90,8 +89,8 @@ fn check(
     Ok(())
 }
 
-/// Zero crossings of a sampled signal (linear interpolation), the period from the first to
-/// the fifth (two periods), and the largest |z| over the samples from `last_from` on.
+/// The tip's zero crossings (linear interpolation between samples) and its largest |z| over
+/// the last period.
 struct Tip {
     z0: f64,
     z: f64,
@@ -119,14 +118,34 @@ impl Tip {
         self.z = z1;
     }
 
-    fn period(&self, what: &str) -> Result<f64, String> {
+    /// The model's row: the period from the first to the fifth zero crossing (two periods).
+    fn row(
+        &self,
+        model: &'static str,
+        along: usize,
+        reference: f64,
+        steps: usize,
+        iterations: usize,
+        t0: Instant,
+    ) -> Result<VibrationRow, String> {
         if self.crossings.len() < 5 {
             return Err(format!(
-                "{what}: the tip crossed zero {} times in {PERIODS} periods (a vibration crosses it six times)",
+                "{model}: the tip crossed zero {} times in {PERIODS} periods (a vibration crosses it six times)",
                 self.crossings.len()
             ));
         }
-        Ok(0.5 * (self.crossings[4] - self.crossings[0]))
+        let period = 0.5 * (self.crossings[4] - self.crossings[0]);
+        Ok(VibrationRow {
+            model,
+            along,
+            period,
+            reference,
+            error_pct: 100.0 * (period - reference) / reference,
+            amplitude_kept: self.last_max / self.z0.abs(),
+            steps,
+            iterations,
+            seconds: t0.elapsed().as_secs_f64(),
+        })
     }
 }
 
@@ -141,28 +160,8 @@ pub fn shell_vibration(
     let t0 = Instant::now();
     let w = 0.25 * l;
     let across = ((along - 1) / 4 + 1).max(3);
-    let domain = [0.0, l, 0.0, w];
-    let fixed = |v: [f64; 3]| Direction::Fixed(v);
-    let problem = ShellProblem {
-        surface: Surface::Plane,
-        domain,
-        nodes: grid_nodes(domain, along, across),
-        material: ShellMaterial::from_fabric(fabric)?,
-        edges: [
-            vec![
-                Constraint::Value(fixed([1.0, 0.0, 0.0])),
-                Constraint::Value(fixed([0.0, 1.0, 0.0])),
-                Constraint::Value(fixed([0.0, 0.0, 1.0])),
-                Constraint::Slope(Direction::Normal),
-            ],
-            vec![],
-            vec![],
-            vec![],
-        ],
-        pins: vec![],
-        area_load: [0.0; 3],
-        point_loads: vec![],
-    };
+    let problem =
+        ShellProblem::clamped_strip(l, w, along, across, ShellMaterial::from_fabric(fabric)?);
     // the start: the static deflection under the first mode's own inertial load
     // ρ ω₁² A φ₁(x)/φ₁(L), point loads at the sample points over their share of the area (the
     // shell's nodal values are not field values, and a start that breaks the clamp's penalty
@@ -210,18 +209,14 @@ pub fn shell_vibration(
         d.step(0.0).map_err(|e| e.to_string())?;
         probe.sample(d.time, params.dt, tip(&d.u)?, s + steps_per_period >= total);
     }
-    let period = probe.period("shell")?;
-    Ok(VibrationRow {
-        model: "shell",
+    probe.row(
+        "shell",
         along,
-        period,
         reference,
-        error_pct: 100.0 * (period - reference) / reference,
-        amplitude_kept: probe.last_max / probe.z0.abs(),
-        steps: d.report.steps,
-        iterations: d.report.newton_iterations,
-        seconds: t0.elapsed().as_secs_f64(),
-    })
+        d.report.steps,
+        d.report.newton_iterations,
+        t0,
+    )
 }
 
 /// The mass-spring strip: `along` particles over its free length (spacing h = L/(along − 1)),
@@ -275,16 +270,5 @@ pub fn mass_spring_vibration(
         iterations += stats.cg_iterations as usize;
         probe.sample(sim.state.time, dt, tip(&sim), s + steps_per_period >= total);
     }
-    let period = probe.period("mass-spring")?;
-    Ok(VibrationRow {
-        model: "mass-spring",
-        along,
-        period,
-        reference,
-        error_pct: 100.0 * (period - reference) / reference,
-        amplitude_kept: probe.last_max / probe.z0.abs(),
-        steps: total,
-        iterations,
-        seconds: t0.elapsed().as_secs_f64(),
-    })
+    probe.row("mass-spring", along, reference, total, iterations, t0)
 }

@@ -127,7 +127,7 @@ pub fn arc_length(
         *u = vec![0.0; n];
     }
     let f_norm = disc.external_load_norm();
-    if !(f_norm > 0.0) {
+    if f_norm.is_nan() || f_norm <= 0.0 {
         return Err(ShellError::Invalid(
             "arc length needs a load (area, point or edge moment)".into(),
         ));

@@ -193,7 +193,7 @@ impl<'a> ShellDynamics<'a> {
                 "dynamics needs 0 < tolerance < 1 and newton_iterations ≥ 1, got {params:?}"
             )));
         }
-        if !(disc.problem.material.density > 0.0) {
+        if disc.problem.material.density.is_nan() || disc.problem.material.density <= 0.0 {
             return Err(ShellError::Invalid(
                 "dynamics needs a material with positive density".into(),
             ));

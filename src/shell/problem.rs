@@ -49,6 +49,42 @@ pub struct ShellProblem {
     pub point_loads: Vec<([f64; 2], [f64; 3])>,
 }
 
+impl ShellProblem {
+    /// A flat strip [0, `l`] × [0, `b`] of `material` on an `along` × `across` grid of points,
+    /// clamped along ξ¹ = 0 (no displacement, no rotation about the edge), free elsewhere,
+    /// unloaded (set `area_load` or `point_loads` after).
+    pub fn clamped_strip(
+        l: f64,
+        b: f64,
+        along: usize,
+        across: usize,
+        material: ShellMaterial,
+    ) -> ShellProblem {
+        let domain = [0.0, l, 0.0, b];
+        let fixed = |v: [f64; 3]| Constraint::Value(Direction::Fixed(v));
+        ShellProblem {
+            surface: Surface::Plane,
+            domain,
+            nodes: grid_nodes(domain, along, across),
+            material,
+            edges: [
+                vec![
+                    fixed([1.0, 0.0, 0.0]),
+                    fixed([0.0, 1.0, 0.0]),
+                    fixed([0.0, 0.0, 1.0]),
+                    Constraint::Slope(Direction::Normal),
+                ],
+                vec![],
+                vec![],
+                vec![],
+            ],
+            pins: vec![],
+            area_load: [0.0; 3],
+            point_loads: vec![],
+        }
+    }
+}
+
 /// How a problem is discretised and solved.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default)]
