@@ -92,3 +92,94 @@ fn a_compressed_strip_follows_the_elastica_through_buckling() {
     );
     assert!(worst < 0.01, "worst error {worst} against the elastica");
 }
+
+/// Snap-through, past a limit point: a shallow sinusoidal arch (span L, rise e = 4r, r = t/√12
+/// the radius of gyration), pinned at immovable supports, under the load q₀ sin(πx/L). Shallow
+/// arch theory solves it in one mode: with a the crown's height (e at rest), the load is
+/// q₀ L⁴/(π⁴ EI) = (e − a) + a (e² − a²)/(4r²), which rises to its limit 8r at a = 2r, falls back
+/// to 0 at a = −2r and rises again (the arch inverted). The asymmetric mode would branch off at
+/// a = 0, past the limit point; the symmetric path is followed.
+#[test]
+fn a_shallow_arch_snaps_through_its_limit_point_at_the_one_mode_load() {
+    use emilion::shell::problem::{Constraint, Direction};
+    use emilion::shell::Surface;
+    let (l, b, t): (f64, f64, f64) = (1.0, 0.1, 0.01);
+    let e_mod = 12.0 / (t * t * t); // D = 1 N·m per unit width
+    let r = t / 12f64.sqrt();
+    let rise = 4.0 * r;
+    let along = 21;
+    // the reference load: q₀ = π⁴ D r / L⁴, so that λ reads q₀ L⁴/(π⁴ EI) in units of r
+    let q_ref = std::f64::consts::PI.powi(4) * r / l.powi(4);
+    let base = ShellProblem::clamped_strip(
+        l,
+        b,
+        along,
+        3,
+        ShellMaterial::isotropic(e_mod, 0.0, t, 0.0).unwrap(),
+    );
+    let pinned = |v: [f64; 3]| Constraint::Value(Direction::Fixed(v));
+    let pins = vec![
+        pinned([1.0, 0.0, 0.0]),
+        pinned([0.0, 1.0, 0.0]),
+        pinned([0.0, 0.0, 1.0]),
+    ];
+    let h = l / (along - 1) as f64;
+    let share = |i: usize, n: usize, d: f64| if i == 0 || i == n - 1 { 0.5 * d } else { d };
+    let point_loads = base
+        .nodes
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let area = share(k % along, along, h) * share(k / along, 3, 0.5 * b);
+            let q = q_ref * (std::f64::consts::PI * p[0] / l).sin();
+            (*p, [0.0, 0.0, -q * area])
+        })
+        .collect();
+    let problem = ShellProblem {
+        surface: Surface::SineArch { span: l, rise },
+        edges: [pins.clone(), pins, vec![], vec![]],
+        point_loads,
+        ..base
+    };
+    let disc = Discretisation::new(problem, ShellParameters::default()).unwrap();
+    let params = ArcLengthParameters {
+        step: 0.2 * r,
+        max_step: 2.0 * r,
+        ..Default::default()
+    };
+    let one_mode = |a: f64| (rise - a) + a * (rise * rise - a * a) / (4.0 * r * r);
+    let (mut u, mut lambda) = (Vec::new(), 0.0);
+    let mut rows = Vec::new();
+    arc_length(&disc, &mut u, &mut lambda, &params, &mut |lam, u| {
+        let a = rise + disc.displacement_at([0.5 * l, 0.5 * b], u).unwrap()[2];
+        rows.push((a / r, lam, one_mode(a) / r));
+        println!(
+            "point a/r {:.4} λ {lam:.5} one mode {:.5}",
+            a / r,
+            one_mode(a) / r
+        );
+        a > -3.0 * r
+    })
+    .unwrap();
+    let mut worst = 0.0f64;
+    for &(a, lam, reference) in &rows {
+        println!("a/r {a:7.3}  q̄/r {lam:8.4}  one mode {reference:8.4}");
+        worst = worst.max((lam - reference).abs());
+    }
+    let peak = rows.iter().map(|r| r.1).fold(f64::NEG_INFINITY, f64::max);
+    let after = rows.iter().skip_while(|r| r.1 < peak).map(|r| r.1);
+    let trough = after.fold(f64::INFINITY, f64::min);
+    println!("{} points: limit load {peak:.4} r (8 r), lowest after it {trough:.4} r (0), worst {worst:.4} r", rows.len());
+    assert!(
+        rows.last().unwrap().0 <= -3.0,
+        "the path stopped at {:?}",
+        rows.last()
+    );
+    // the limit and the trough within 2 % of the limit load; the path within 3 %
+    assert!((peak - 8.0).abs() < 0.16, "limit load {peak} r against 8 r");
+    assert!(trough.abs() < 0.16, "trough {trough} r against 0");
+    assert!(
+        worst < 0.24,
+        "the path strays {worst} r from the one-mode curve"
+    );
+}

@@ -34,7 +34,8 @@ pub struct ArcLengthParameters {
     pub aim_iterations: usize,
     /// Most corrector iterations before a step is retried at half the length.
     pub max_iterations: usize,
-    /// A point has converged when |R| ≤ this × |F|.
+    /// A point has converged when |R| ≤ this × |λ F| (or when the corrector stalls, at the
+    /// rounding floor, under a hundred times this).
     pub tolerance: f64,
     /// Most steps (accepted and retried).
     pub max_steps: usize,
@@ -153,6 +154,7 @@ pub fn arc_length(
         let mut dl = sign * ds / norm_uf;
         let mut du: Vec<f64> = uf.iter().map(|x| dl * x).collect();
         let mut done = None;
+        let mut previous_rel = f64::INFINITY;
         for it in 1..=params.max_iterations {
             for i in 0..n {
                 u[i] = u0[i] + du[i];
@@ -163,10 +165,15 @@ pub fn arc_length(
             if !rel.is_finite() {
                 break;
             }
-            if rel <= params.tolerance {
+            // converged, or stalled at the rounding floor within a hundred times the tolerance
+            // (the penalties' large, cancelling forces set that floor where λ is small)
+            if rel <= params.tolerance
+                || (rel <= 100.0 * params.tolerance && rel > 0.5 * previous_rel)
+            {
                 done = Some(it - 1);
                 break;
             }
+            previous_rel = rel;
             let f = load_vector(disc, u);
             let minus_r: Vec<f64> = r.iter().map(|x| -x).collect();
             let (ur, uf) = match solve_two(&k, &minus_r, &f, &mut symbolic) {

@@ -1,6 +1,7 @@
 //! The rest mid-surface of a shell as a map X(ξ¹, ξ²) from a rectangle of the parameter plane,
 //! with its first and second derivatives: a plane, a cylinder or a sphere, parametrised by
-//! arc length so that the parameter plane's distances are (nearly) the surface's own.
+//! arc length so that the parameter plane's distances are (nearly) the surface's own, or a
+//! shallow sinusoidal arch over the plane.
 
 use nalgebra::Vector3;
 
@@ -34,6 +35,14 @@ pub enum Surface {
         /// Radius (m).
         radius: f64,
     },
+    /// A sinusoidal arch over the plane, crown on +z: X = (ξ¹, ξ², e sin(π ξ¹ / L)) (the
+    /// parameters are the plane's, not arc length: meant for shallow arches).
+    SineArch {
+        /// Span L (m): the arch spans ξ¹ in [0, L].
+        span: f64,
+        /// Rise e (m).
+        rise: f64,
+    },
 }
 
 impl Surface {
@@ -52,6 +61,15 @@ impl Surface {
                     x: V3::new(xi[0], r * s, r * c),
                     d1: [V3::x(), V3::new(0.0, c, -s)],
                     d2: [z, z, V3::new(0.0, -s / r, -c / r)],
+                }
+            }
+            Surface::SineArch { span, rise } => {
+                let k = std::f64::consts::PI / span;
+                let (s, c) = (k * xi[0]).sin_cos();
+                SurfacePoint {
+                    x: V3::new(xi[0], xi[1], rise * s),
+                    d1: [V3::new(1.0, 0.0, rise * k * c), V3::y()],
+                    d2: [V3::new(0.0, 0.0, -rise * k * k * s), z, z],
                 }
             }
             Surface::Sphere { radius: r } => {
@@ -73,10 +91,19 @@ impl Surface {
         }
     }
 
-    /// Checks the radius (finite, > 0).
+    /// Checks the radius, span and rise (finite, > 0).
     pub fn validate(&self) -> Result<(), String> {
         match *self {
             Surface::Plane => Ok(()),
+            Surface::SineArch { span, rise } => {
+                if span.is_finite() && span > 0.0 && rise.is_finite() && rise > 0.0 {
+                    Ok(())
+                } else {
+                    Err(format!(
+                        "arch span and rise must be positive and finite, got {span} and {rise}"
+                    ))
+                }
+            }
             Surface::Cylinder { radius } | Surface::Sphere { radius } => {
                 if radius.is_finite() && radius > 0.0 {
                     Ok(())
