@@ -214,11 +214,17 @@ impl Discretisation {
             }
             Ok(out)
         };
-        let parts: Result<Vec<Vec<QuadPoint>>, ShellError> = (0..cells[0] * cells[1])
+        // every cell's result kept, so that the error reported is the first cell's in order,
+        // whichever thread failed first (a collect into Result stops at any error)
+        let parts: Vec<Result<Vec<QuadPoint>, ShellError>> = (0..cells[0] * cells[1])
             .into_par_iter()
             .map(per_cell)
             .collect();
-        Ok(parts?.concat())
+        let mut out = Vec::new();
+        for part in parts {
+            out.extend(part?);
+        }
+        Ok(out)
     }
 
     fn node_terms(&self, cells: [usize; 2]) -> Result<Vec<NodeTerms>, ShellError> {
