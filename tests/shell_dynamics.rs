@@ -156,3 +156,43 @@ fn newmark_keeps_the_energy_of_a_large_swing_and_backward_euler_loses_it() {
         euler.1
     );
 }
+
+#[test]
+fn bad_parameters_and_states_are_errors_naming_them() {
+    use emilion::shell::arc_length::{arc_length, ArcLengthParameters};
+    let disc = strip(15, 0.0);
+    let n = 3 * disc.len();
+    let run = |params: DynamicsParameters, u: Vec<f64>| {
+        ShellDynamics::new(&disc, None, params, u, Vec::new(), 0.0)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default()
+    };
+    let nan_dt = DynamicsParameters {
+        dt: f64::NAN,
+        ..Default::default()
+    };
+    assert!(run(nan_dt, Vec::new()).contains("`dt`"));
+    let ok = DynamicsParameters::default();
+    assert!(run(ok, vec![0.0; n - 1]).contains(&format!("expected {n}")));
+    let mut nan_u = vec![0.0; n];
+    nan_u[4] = f64::NAN;
+    assert!(run(ok, nan_u).contains("non-finite"));
+    // arc length: a zero step, and a shell with no load to follow
+    let (mut u, mut lambda) = (Vec::new(), 0.0);
+    let zero_step = ArcLengthParameters {
+        step: 0.0,
+        ..Default::default()
+    };
+    let e = arc_length(&disc, &mut u, &mut lambda, &zero_step, &mut |_, _| true).unwrap_err();
+    assert!(e.to_string().contains("0 < step"), "{e}");
+    let e = arc_length(
+        &disc,
+        &mut u,
+        &mut lambda,
+        &Default::default(),
+        &mut |_, _| true,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("needs a load"), "{e}");
+}

@@ -8,7 +8,8 @@
 //! K is indefinite: past a limit point) and solves it twice, δu_R = −K⁻¹R and δu_F = K⁻¹F; the
 //! load change δλ is the root of |Δu + δu_R + δλ δu_F|² = Δs² that keeps the step going the way
 //! it went (the larger (Δu + δu)·Δu). The predictor's direction follows the previous step
-//! (Δu_prev · δu_F), so the path turns back at a limit point instead of reversing. Δs adapts
+//! (Δu_prev · δu_F), so the path turns back at a limit point instead of reversing; it reuses
+//! the tangent that the corrector reaching the point assembled there. Δs adapts
 //! to the corrector's iteration count; a step whose quadratic has no real root or that does not
 //! converge is retried at half the length.
 
@@ -69,32 +70,37 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-/// K⁻¹ a and K⁻¹ b from one factorisation (Cholesky, LU if K is not positive definite).
-fn solve_two(
+/// K⁻¹ b for each right-hand side b, from one factorisation (Cholesky, LU if K is not
+/// positive definite).
+fn solve_each(
     k: &SparseColMat<usize, f64>,
-    a: &[f64],
-    b: &[f64],
+    rhs: &[&[f64]],
     symbolic: &mut Symbolic,
-) -> Result<(Vec<f64>, Vec<f64>), ShellError> {
-    let ca = Col::<f64>::from_fn(a.len(), |i| a[i]);
-    let cb = Col::<f64>::from_fn(b.len(), |i| b[i]);
-    let (xa, xb) = match Llt::try_new_with_symbolic(symbolic.llt(k)?, k.as_ref(), Side::Lower) {
-        Ok(llt) => (llt.solve(&ca), llt.solve(&cb)),
-        Err(_) => {
-            let lu = Lu::try_new_with_symbolic(symbolic.lu(k)?, k.as_ref()).map_err(|e| {
-                ShellError::Solver(format!("sparse LU of the tangent failed: {e:?}"))
-            })?;
-            (lu.solve(&ca), lu.solve(&cb))
-        }
-    };
-    let xa: Vec<f64> = (0..a.len()).map(|i| xa[i]).collect();
-    let xb: Vec<f64> = (0..b.len()).map(|i| xb[i]).collect();
-    if !xa.iter().chain(&xb).all(|v| v.is_finite()) {
+) -> Result<Vec<Vec<f64>>, ShellError> {
+    let cols: Vec<Col<f64>> = rhs
+        .iter()
+        .map(|b| Col::<f64>::from_fn(b.len(), |i| b[i]))
+        .collect();
+    let xs: Vec<Col<f64>> =
+        match Llt::try_new_with_symbolic(symbolic.llt(k)?, k.as_ref(), Side::Lower) {
+            Ok(llt) => cols.iter().map(|c| llt.solve(c)).collect(),
+            Err(_) => {
+                let lu = Lu::try_new_with_symbolic(symbolic.lu(k)?, k.as_ref()).map_err(|e| {
+                    ShellError::Solver(format!("sparse LU of the tangent failed: {e:?}"))
+                })?;
+                cols.iter().map(|c| lu.solve(c)).collect()
+            }
+        };
+    let xs: Vec<Vec<f64>> = xs
+        .iter()
+        .map(|x| (0..x.nrows()).map(|i| x[i]).collect())
+        .collect();
+    if !xs.iter().flatten().all(|v| v.is_finite()) {
         return Err(ShellError::Solver(
             "the tangent is singular (a rigid-body motion left free? add supports or pins)".into(),
         ));
     }
-    Ok((xa, xb))
+    Ok(xs)
 }
 
 /// F(u) = R(u, 0) − R(u, 1): the load the factor multiplies (dead loads, edge moments).
@@ -138,14 +144,19 @@ pub fn arc_length(
     let mut previous: Option<Vec<f64>> = None;
     let mut path = Vec::new();
     let mut tries = 0;
+    // the tangent and load vector at the current point (kept from the corrector that reached it)
+    let mut point: Option<(SparseColMat<usize, f64>, Vec<f64>)> = None;
     while tries < params.max_steps {
         limits::check_cancelled().map_err(ShellError::Solver)?;
         tries += 1;
         let (u0, l0) = (u.clone(), *lambda);
         // predictor along the tangent, the way the path went
-        let (_, k) = residual_and_tangent(disc, u, *lambda)?;
-        let f = load_vector(disc, u);
-        let (uf, _) = solve_two(&k, &f, &f, &mut symbolic)?;
+        if point.is_none() {
+            let (_, k) = residual_and_tangent(disc, u, *lambda)?;
+            point = Some((k, load_vector(disc, u)));
+        }
+        let (k0, f0) = point.as_ref().expect("set above");
+        let uf = solve_each(k0, &[f0], &mut symbolic)?.remove(0);
         let norm_uf = dot(&uf, &uf).sqrt();
         let sign = match &previous {
             Some(p) if dot(p, &uf) < 0.0 => -1.0,
@@ -170,14 +181,14 @@ pub fn arc_length(
             if rel <= params.tolerance
                 || (rel <= 100.0 * params.tolerance && rel > 0.5 * previous_rel)
             {
-                done = Some(it - 1);
+                done = Some((it - 1, k));
                 break;
             }
             previous_rel = rel;
             let f = load_vector(disc, u);
             let minus_r: Vec<f64> = r.iter().map(|x| -x).collect();
-            let (ur, uf) = match solve_two(&k, &minus_r, &f, &mut symbolic) {
-                Ok(x) => x,
+            let (ur, uf) = match solve_each(&k, &[&minus_r, &f], &mut symbolic) {
+                Ok(mut x) => (x.remove(0), x.remove(0)),
                 Err(_) => break,
             };
             // |du + ur + δλ uf|² = ds²
@@ -203,7 +214,8 @@ pub fn arc_length(
             dl += dlam;
         }
         match done {
-            Some(iterations) => {
+            Some((iterations, k)) => {
+                point = Some((k, load_vector(disc, u)));
                 path.push(PathPoint {
                     lambda: *lambda,
                     iterations,

@@ -132,27 +132,10 @@ pub fn heavy_cantilever(
     let material = ShellMaterial::isotropic(e, 0.0, t, 0.0).map_err(ShellError::Invalid)?;
     let bend = e * t * t * t / 12.0;
     let lam_max = 20.0;
-    let domain = [0.0, l, 0.0, b];
     let across = ((b / l * (n - 1) as f64).round() as usize + 1).max(3);
     let problem = ShellProblem {
-        surface: Surface::Plane,
-        domain,
-        nodes: grid_nodes(domain, n, across),
-        material,
-        edges: [
-            vec![
-                Constraint::Value(X),
-                Constraint::Value(Y),
-                Constraint::Value(Z),
-                Constraint::Slope(N),
-            ],
-            vec![],
-            vec![],
-            vec![],
-        ],
-        pins: vec![],
         area_load: [0.0, 0.0, -lam_max * bend / l.powi(3)],
-        point_loads: vec![],
+        ..ShellProblem::clamped_strip(l, b, n, across, material)
     };
     let mut disc = Discretisation::new(problem, params)?;
     let mut u = Vec::new();

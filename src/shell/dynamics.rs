@@ -84,6 +84,8 @@ pub struct ShellDynamics<'a> {
     obstacle: Option<&'a SphereObstacle>,
     params: DynamicsParameters,
     mass: SparseColMat<usize, f64>,
+    /// M/(β Δt²) as tangent entries (Δt and β are fixed for the run).
+    mass_entries: Vec<Entry>,
     symbolic: Symbolic,
     /// Displacement (3 per node).
     pub u: Vec<f64>,
@@ -99,6 +101,15 @@ pub struct ShellDynamics<'a> {
 
 fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// Newmark's β of the integrator (u₁ = ũ + β Δt² a₁; backward Euler is β = 1 about its own
+/// predictor).
+fn beta(integrator: Integrator) -> f64 {
+    match integrator {
+        Integrator::Newmark => 0.25,
+        Integrator::BackwardEuler => 1.0,
+    }
 }
 
 /// The mass matrix of `disc` (3 rows per node, the identity in each node block).
@@ -224,10 +235,19 @@ impl<'a> ShellDynamics<'a> {
         let mut a = vec![0.0; n];
         let mut symbolic = Symbolic::default();
         newton_step(&r, &mass, &mut a, &mut symbolic)?;
+        let c = 1.0 / (beta(params.integrator) * params.dt * params.dt);
+        let s = mass.symbolic();
+        let mut mass_entries = Vec::with_capacity(mass.val().len());
+        for col in 0..n {
+            for k in s.col_ptr()[col]..s.col_ptr()[col + 1] {
+                mass_entries.push(Triplet::new(s.row_idx()[k], col, c * mass.val()[k]));
+            }
+        }
         Ok(ShellDynamics {
             disc,
             obstacle,
             params,
+            mass_entries,
             mass,
             symbolic: Symbolic::default(),
             u,
@@ -252,9 +272,10 @@ impl<'a> ShellDynamics<'a> {
         let dt = self.params.dt;
         let n = self.u.len();
         // u₁ = ũ + β Δt² a₁: the predictor ũ and c = 1/(β Δt²)
-        let (beta, gamma) = match self.params.integrator {
-            Integrator::Newmark => (0.25, 0.5),
-            Integrator::BackwardEuler => (1.0, 1.0),
+        let beta = beta(self.params.integrator);
+        let gamma = match self.params.integrator {
+            Integrator::Newmark => 0.5,
+            Integrator::BackwardEuler => 1.0,
         };
         let predictor: Vec<f64> = (0..n)
             .map(|i| match self.params.integrator {
@@ -265,16 +286,6 @@ impl<'a> ShellDynamics<'a> {
             })
             .collect();
         let c = 1.0 / (beta * dt * dt);
-        let mass_trip: Vec<Entry> = {
-            let s = self.mass.symbolic();
-            let mut t = Vec::with_capacity(self.mass.val().len());
-            for col in 0..n {
-                for k in s.col_ptr()[col]..s.col_ptr()[col + 1] {
-                    t.push(Triplet::new(s.row_idx()[k], col, c * self.mass.val()[k]));
-                }
-            }
-            t
-        };
         // the force that would stop the motion in one step: the scale near a rest point
         let momentum = norm(&mass_times(&self.mass, &self.v)) / dt;
         let mut u1 = self.u.clone();
@@ -311,7 +322,7 @@ impl<'a> ShellDynamics<'a> {
             if it == self.params.newton_iterations {
                 break;
             }
-            trip.extend_from_slice(&mass_trip);
+            trip.extend_from_slice(&self.mass_entries);
             let k = tangent_matrix(self.disc, &trip)?;
             self.report.newton_iterations += 1;
             newton_step(&res, &k, &mut u1, &mut self.symbolic).map_err(|e| {
